@@ -1,0 +1,130 @@
+//! `linkage bench`: the phases of the linear solve on 3D box lattices of growing size.
+
+use crate::linkage::{generators, Body, Equilibrium, Material, NodalLoad, Schedule, Support};
+use crate::Real;
+use nalgebra::Vector3;
+use std::time::Instant;
+
+/// One measured lattice.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LatticeTiming {
+    /// Cells per direction.
+    pub cells: [usize; 3],
+    /// Nodes.
+    pub nodes: usize,
+    /// Members.
+    pub members: usize,
+    /// Free DOFs.
+    pub free_dofs: usize,
+    /// Entries of the lower triangle of `K_ff`.
+    pub matrix_entries: usize,
+    /// Entries of the Cholesky factor.
+    pub factor_entries: usize,
+    /// Generating the lattice, s.
+    pub generate: Real,
+    /// Assembly of `K_ff`, s.
+    pub assembly: Real,
+    /// Ordering and symbolic factorization, s.
+    pub symbolic: Real,
+    /// Numeric factorization, s.
+    pub numeric: Real,
+    /// Triangular solve, s.
+    pub solve: Real,
+    /// Relative equilibrium residual of the answer.
+    pub residual: Real,
+    /// Peak resident memory of the process, bytes (0 where unknown).
+    pub peak_memory: u64,
+}
+
+/// A steel lattice of `cells` unit cells (0.01 m each), bottom face fixed, the top face
+/// pushed down and sideways by 1 kN in total.
+pub fn lattice_body(cells: [usize; 3]) -> Result<Body, String> {
+    let h = 0.01;
+    let size = [
+        cells[0] as Real * h,
+        cells[1] as Real * h,
+        cells[2] as Real * h,
+    ];
+    let geometry = generators::box_lattice(size, cells).map_err(|e| e.to_string())?;
+    let mut body = Body::from_geometry("lattice", geometry, Material::new("steel", 200e9, 1e-6));
+    let top: Vec<usize> = (0..body.nodes.len())
+        .filter(|&i| (body.nodes[i].z - size[2]).abs() < 1e-9)
+        .collect();
+    for i in 0..body.nodes.len() {
+        if body.nodes[i].z.abs() < 1e-9 {
+            body.supports.push(Support::fixed(i, [true, true, true]));
+        }
+    }
+    let per_node = Vector3::new(200.0, 0.0, -1000.0) / top.len() as Real;
+    for i in top {
+        body.loads.push(NodalLoad {
+            node: i,
+            force: per_node,
+            schedule: Schedule::Linear,
+        });
+    }
+    Ok(body)
+}
+
+/// Generate, assemble, factor and solve one lattice, timing each phase.
+pub fn measure_lattice(cells: [usize; 3]) -> Result<LatticeTiming, String> {
+    let t = Instant::now();
+    let body = lattice_body(cells)?;
+    let generate = t.elapsed().as_secs_f64();
+    let eq = Equilibrium::new(&body).map_err(|e| e.to_string())?;
+    let state = eq.solve_step(&body, 1, 1).map_err(|e| e.to_string())?;
+    Ok(LatticeTiming {
+        cells,
+        nodes: body.nodes.len(),
+        members: body.members.len(),
+        free_dofs: eq.assembly.n,
+        matrix_entries: eq.assembly.nnz(),
+        factor_entries: eq.factor_entries,
+        generate,
+        assembly: eq.times.assembly,
+        symbolic: eq.times.symbolic,
+        numeric: eq.times.numeric,
+        solve: eq.times.solve,
+        residual: state.residual,
+        peak_memory: peak_memory(),
+    })
+}
+
+/// Peak resident set size of this process (VmHWM), bytes; 0 where /proc is unavailable.
+pub fn peak_memory() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<u64>().ok())
+        })
+        .map(|kb| kb * 1024)
+        .unwrap_or(0)
+}
+
+/// The table header printed by `linkage bench`.
+pub const HEADER: &str = "cells        nodes    members   free DOFs   nnz(K_ff)     nnz(L)  generate  assembly  symbolic   numeric     solve     total  residual   peak MB";
+
+/// One table row.
+pub fn format_row(t: &LatticeTiming) -> String {
+    let total = t.assembly + t.symbolic + t.numeric + t.solve;
+    format!(
+        "{:<10} {:>8} {:>10} {:>11} {:>11} {:>10} {:>8.3}s {:>8.3}s {:>8.3}s {:>8.3}s {:>8.3}s {:>8.3}s {:>9.1e} {:>9.0}",
+        format!("{}x{}x{}", t.cells[0], t.cells[1], t.cells[2]),
+        t.nodes,
+        t.members,
+        t.free_dofs,
+        t.matrix_entries,
+        t.factor_entries,
+        t.generate,
+        t.assembly,
+        t.symbolic,
+        t.numeric,
+        t.solve,
+        total,
+        t.residual,
+        t.peak_memory as f64 / 1048576.0
+    )
+}

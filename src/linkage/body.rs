@@ -1,0 +1,491 @@
+use crate::linkage::{Geometry, Material};
+use crate::Real;
+use nalgebra::Vector3;
+
+/// Whether a body lives in the plane z = 0 (two DOFs per node) or in space (three).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Dimension {
+    /// Plane body: nodes at z = 0, DOFs x and y.
+    #[default]
+    Two,
+    /// Space body: DOFs x, y and z.
+    Three,
+}
+
+impl Dimension {
+    /// Degrees of freedom per node: 2 or 3.
+    pub fn dofs_per_node(self) -> usize {
+        match self {
+            Dimension::Two => 2,
+            Dimension::Three => 3,
+        }
+    }
+}
+
+/// An axial member: two node indices (0-based) and the index of its material in `Body::materials`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Member {
+    /// End nodes, 0-based.
+    pub nodes: [usize; 2],
+    /// Index into `Body::materials`.
+    pub material: usize,
+}
+
+/// How a load or a prescribed displacement grows over the load steps.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Schedule {
+    /// `step / steps`: zero at step 0, full value at the last step.
+    #[default]
+    Linear,
+    /// An explicit factor per step 1..=steps (`factors[k - 1]` at step k); zero at step 0.
+    Factors(Vec<Real>),
+}
+
+impl Schedule {
+    /// The factor applied at `step` of `steps` (step 0 is the undeformed state).
+    pub fn factor(&self, step: usize, steps: usize) -> Real {
+        if step == 0 {
+            return 0.0;
+        }
+        match self {
+            Schedule::Linear => step as Real / steps.max(1) as Real,
+            Schedule::Factors(f) => f.get(step - 1).copied().unwrap_or(0.0),
+        }
+    }
+}
+
+/// A support: some directions of one node held, optionally at a prescribed displacement.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Support {
+    /// Supported node, 0-based.
+    pub node: usize,
+    /// Which of x, y, z are held (z is ignored in 2D).
+    pub fixed: [bool; 3],
+    /// Prescribed displacement of the held directions at full schedule, m (free directions: 0).
+    pub displacement: Vector3<Real>,
+    /// How the prescribed displacement grows over the steps.
+    pub schedule: Schedule,
+}
+
+impl Support {
+    /// A support that holds `fixed` directions of `node` in place.
+    pub fn fixed(node: usize, fixed: [bool; 3]) -> Self {
+        Support {
+            node,
+            fixed,
+            displacement: Vector3::zeros(),
+            schedule: Schedule::Linear,
+        }
+    }
+}
+
+/// A force applied at a node, N, at full schedule.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NodalLoad {
+    /// Loaded node, 0-based.
+    pub node: usize,
+    /// Force at full schedule, N (z is zero in 2D).
+    pub force: Vector3<Real>,
+    /// How the force grows over the steps.
+    pub schedule: Schedule,
+}
+
+/// One deformable body: a linkage of nodes and members with its supports and loads.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Body {
+    /// Name, unique in a scene; names the body in results and messages.
+    pub name: String,
+    /// 2D or 3D.
+    pub dimension: Dimension,
+    /// Undeformed node positions, m (z = 0 in 2D).
+    pub nodes: Vec<Vector3<Real>>,
+    /// Axial members.
+    pub members: Vec<Member>,
+    /// Outward-facing triangular surface patches, node indices (3D).
+    pub patches: Vec<[usize; 3]>,
+    /// Materials referred to by the members.
+    pub materials: Vec<Material>,
+    /// Supports; a node may appear in several (their fixed directions combine).
+    pub supports: Vec<Support>,
+    /// Applied nodal forces.
+    pub loads: Vec<NodalLoad>,
+}
+
+/// Why a body cannot be solved as given. Numbers in messages are 1-based.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum BodyError {
+    /// A material with a bad value.
+    #[error("body '{body}': material '{material}': {problem}")]
+    Material {
+        body: String,
+        material: String,
+        problem: String,
+    },
+    /// A node coordinate that is NaN or infinite.
+    #[error("body '{body}': node {node} has a non-finite coordinate {value}: give finite numbers in metres")]
+    NonFiniteNode {
+        body: String,
+        node: usize,
+        value: Real,
+    },
+    /// A 2D body with a node off the plane z = 0.
+    #[error("body '{body}': node {node} has z = {z} but the body is 2D: 2D nodes lie in the plane z = 0")]
+    NodeOffPlane { body: String, node: usize, z: Real },
+    /// A member whose node number does not exist.
+    #[error("body '{body}': member {member} names node {node}, but the body has {count} nodes (numbers start at 1)")]
+    NodeOutOfRange {
+        body: String,
+        member: usize,
+        node: usize,
+        count: usize,
+    },
+    /// A member joining a node to itself.
+    #[error("body '{body}': member {member} joins node {node} to itself: a member needs two different nodes")]
+    SelfMember {
+        body: String,
+        member: usize,
+        node: usize,
+    },
+    /// A member whose nodes coincide.
+    #[error("body '{body}': member {member} joins nodes {a} and {b}, which are at the same place (length {length:e} m): move one node or merge them")]
+    ZeroLength {
+        body: String,
+        member: usize,
+        a: usize,
+        b: usize,
+        length: Real,
+    },
+    /// Two members joining the same pair of nodes.
+    #[error("body '{body}': member {member} joins nodes {a} and {b}, as member {first} already does: remove one (to stiffen a link, use a material with a larger area)")]
+    DuplicateMember {
+        body: String,
+        member: usize,
+        first: usize,
+        a: usize,
+        b: usize,
+    },
+    /// A member whose material index does not exist.
+    #[error("body '{body}': member {member} refers to material #{material}, which does not exist")]
+    MaterialOutOfRange {
+        body: String,
+        member: usize,
+        material: usize,
+    },
+    /// A patch that names a missing node or repeats a node.
+    #[error("body '{body}': patch {patch} ({nodes:?}) {problem}")]
+    BadPatch {
+        body: String,
+        patch: usize,
+        nodes: [usize; 3],
+        problem: String,
+    },
+    /// A node that no member touches: it could move freely.
+    #[error("body '{body}': node {node} belongs to no member, so nothing holds it: join it with members or remove it")]
+    LooseNode { body: String, node: usize },
+    /// A body with no supports at all.
+    #[error("body '{body}' has no supports, so it can move as a rigid body: add [[bodies.supports]] that hold it")]
+    NoSupports { body: String },
+    /// A support or load on a node that does not exist.
+    #[error("body '{body}': {what} names node {node}, but the body has {count} nodes")]
+    TargetOutOfRange {
+        body: String,
+        what: String,
+        node: usize,
+        count: usize,
+    },
+    /// A non-finite load, displacement or schedule, or a z component in 2D.
+    #[error("body '{body}': {what}: {problem}")]
+    BadValue {
+        body: String,
+        what: String,
+        problem: String,
+    },
+}
+
+impl Body {
+    /// An empty body.
+    pub fn new(name: &str, dimension: Dimension) -> Self {
+        Body {
+            name: name.to_string(),
+            dimension,
+            ..Default::default()
+        }
+    }
+
+    /// A body from a geometry whose members all use `material`.
+    pub fn from_geometry(name: &str, geometry: Geometry, material: Material) -> Self {
+        Body {
+            name: name.to_string(),
+            dimension: geometry.dimension,
+            nodes: geometry.nodes,
+            members: geometry
+                .members
+                .into_iter()
+                .map(|nodes| Member { nodes, material: 0 })
+                .collect(),
+            patches: geometry.patches,
+            materials: vec![material],
+            supports: Vec::new(),
+            loads: Vec::new(),
+        }
+    }
+
+    /// Number of degrees of freedom: nodes × (2 or 3).
+    pub fn dof_count(&self) -> usize {
+        self.nodes.len() * self.dimension.dofs_per_node()
+    }
+
+    /// Undeformed length of member `m`, m.
+    pub fn member_length(&self, m: usize) -> Real {
+        let [a, b] = self.members[m].nodes;
+        (self.nodes[b] - self.nodes[a]).norm()
+    }
+
+    /// The diagonal of the bounding box of the nodes, m: the model's length scale.
+    pub fn size(&self) -> Real {
+        bounding_diagonal(&self.nodes)
+    }
+
+    /// Check everything that can be checked before solving; the first problem found is returned.
+    pub fn validate(&self) -> Result<(), BodyError> {
+        let body = || self.name.clone();
+        for m in &self.materials {
+            if let Some(problem) = m.problem() {
+                return Err(BodyError::Material {
+                    body: body(),
+                    material: m.name.clone(),
+                    problem,
+                });
+            }
+        }
+        for (i, p) in self.nodes.iter().enumerate() {
+            if let Some(v) = p.iter().find(|v| !v.is_finite()) {
+                return Err(BodyError::NonFiniteNode {
+                    body: body(),
+                    node: i + 1,
+                    value: *v,
+                });
+            }
+            if self.dimension == Dimension::Two && p.z != 0.0 {
+                return Err(BodyError::NodeOffPlane {
+                    body: body(),
+                    node: i + 1,
+                    z: p.z,
+                });
+            }
+        }
+        check_members(&self.nodes, self.members.iter().map(|m| m.nodes))
+            .map_err(|p| p.into_body_error(self))?;
+        for (i, m) in self.members.iter().enumerate() {
+            if m.material >= self.materials.len() {
+                return Err(BodyError::MaterialOutOfRange {
+                    body: body(),
+                    member: i + 1,
+                    material: m.material + 1,
+                });
+            }
+        }
+        for (i, t) in self.patches.iter().enumerate() {
+            let problem = if t.iter().any(|&n| n >= self.nodes.len()) {
+                Some(format!(
+                    "names a node beyond the {} nodes",
+                    self.nodes.len()
+                ))
+            } else if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                Some("repeats a node: a patch needs three different nodes".to_string())
+            } else {
+                None
+            };
+            if let Some(problem) = problem {
+                return Err(BodyError::BadPatch {
+                    body: body(),
+                    patch: i + 1,
+                    nodes: t.map(|n| n + 1),
+                    problem,
+                });
+            }
+        }
+        let mut touched = vec![false; self.nodes.len()];
+        for m in &self.members {
+            touched[m.nodes[0]] = true;
+            touched[m.nodes[1]] = true;
+        }
+        if let Some(n) = touched.iter().position(|t| !t) {
+            return Err(BodyError::LooseNode {
+                body: body(),
+                node: n + 1,
+            });
+        }
+        if self.supports.iter().all(|s| !s.fixed.iter().any(|f| *f)) {
+            return Err(BodyError::NoSupports { body: body() });
+        }
+        for (i, s) in self.supports.iter().enumerate() {
+            let what = format!("support {} (node {})", i + 1, s.node + 1);
+            self.check_target(&what, s.node)?;
+            self.check_vector(&what, "displacement", &s.displacement)?;
+            for d in 0..3 {
+                if !s.fixed[d] && s.displacement[d] != 0.0 {
+                    return Err(BodyError::BadValue {
+                        body: body(),
+                        what,
+                        problem: format!(
+                            "a displacement is prescribed in direction {} which the support does not fix: add it to `fix`",
+                            ["x", "y", "z"][d]
+                        ),
+                    });
+                }
+            }
+            self.check_schedule(&what, &s.schedule)?;
+        }
+        for (i, l) in self.loads.iter().enumerate() {
+            let what = format!("load {} (node {})", i + 1, l.node + 1);
+            self.check_target(&what, l.node)?;
+            self.check_vector(&what, "force", &l.force)?;
+            self.check_schedule(&what, &l.schedule)?;
+        }
+        Ok(())
+    }
+
+    fn check_target(&self, what: &str, node: usize) -> Result<(), BodyError> {
+        if node >= self.nodes.len() {
+            return Err(BodyError::TargetOutOfRange {
+                body: self.name.clone(),
+                what: what.to_string(),
+                node: node + 1,
+                count: self.nodes.len(),
+            });
+        }
+        Ok(())
+    }
+
+    fn check_vector(&self, what: &str, key: &str, v: &Vector3<Real>) -> Result<(), BodyError> {
+        let problem = if v.iter().any(|c| !c.is_finite()) {
+            Some(format!("{key} {:?} is not finite", v.as_slice()))
+        } else if self.dimension == Dimension::Two && v.z != 0.0 {
+            Some(format!("{key} has a z component in a 2D body"))
+        } else {
+            None
+        };
+        match problem {
+            Some(problem) => Err(BodyError::BadValue {
+                body: self.name.clone(),
+                what: what.to_string(),
+                problem,
+            }),
+            None => Ok(()),
+        }
+    }
+
+    fn check_schedule(&self, what: &str, s: &Schedule) -> Result<(), BodyError> {
+        if let Schedule::Factors(f) = s {
+            if let Some(v) = f.iter().find(|v| !v.is_finite()) {
+                return Err(BodyError::BadValue {
+                    body: self.name.clone(),
+                    what: what.to_string(),
+                    problem: format!("schedule factor {v} is not finite"),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What is wrong with one member of a list, by 0-based member index (see [`check_members`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum MemberProblem {
+    /// A node index past the end.
+    NodeOutOfRange { member: usize, node: usize },
+    /// Both ends the same node.
+    SelfMember { member: usize, node: usize },
+    /// The two nodes coincide.
+    ZeroLength { member: usize, length: Real },
+    /// The same pair as an earlier member.
+    Duplicate { member: usize, first: usize },
+}
+
+impl MemberProblem {
+    /// The member (0-based) the problem is about.
+    pub fn member(&self) -> usize {
+        match *self {
+            MemberProblem::NodeOutOfRange { member, .. }
+            | MemberProblem::SelfMember { member, .. }
+            | MemberProblem::ZeroLength { member, .. }
+            | MemberProblem::Duplicate { member, .. } => member,
+        }
+    }
+
+    fn into_body_error(self, b: &Body) -> BodyError {
+        let body = b.name.clone();
+        let count = b.nodes.len();
+        let ends = |m: usize| b.members[m].nodes.map(|n| n + 1);
+        match self {
+            MemberProblem::NodeOutOfRange { member, node } => BodyError::NodeOutOfRange {
+                body,
+                member: member + 1,
+                node: node + 1,
+                count,
+            },
+            MemberProblem::SelfMember { member, node } => BodyError::SelfMember {
+                body,
+                member: member + 1,
+                node: node + 1,
+            },
+            MemberProblem::ZeroLength { member, length } => BodyError::ZeroLength {
+                body,
+                member: member + 1,
+                a: ends(member)[0],
+                b: ends(member)[1],
+                length,
+            },
+            MemberProblem::Duplicate { member, first } => BodyError::DuplicateMember {
+                body,
+                member: member + 1,
+                first: first + 1,
+                a: ends(member)[0],
+                b: ends(member)[1],
+            },
+        }
+    }
+}
+
+/// Check members against the nodes: indices in range, two distinct nodes, non-zero
+/// length (below 1e-12 of the model size counts as zero), no pair repeated.
+pub fn check_members(
+    nodes: &[Vector3<Real>],
+    members: impl Iterator<Item = [usize; 2]>,
+) -> Result<(), MemberProblem> {
+    let scale = bounding_diagonal(nodes);
+    let mut seen = std::collections::HashMap::new();
+    for (i, [a, b]) in members.enumerate() {
+        if let Some(&n) = [a, b].iter().find(|&&n| n >= nodes.len()) {
+            return Err(MemberProblem::NodeOutOfRange { member: i, node: n });
+        }
+        if a == b {
+            return Err(MemberProblem::SelfMember { member: i, node: a });
+        }
+        let length = (nodes[b] - nodes[a]).norm();
+        if length <= 1e-12 * scale || length == 0.0 {
+            return Err(MemberProblem::ZeroLength { member: i, length });
+        }
+        if let Some(&first) = seen.get(&(a.min(b), a.max(b))) {
+            return Err(MemberProblem::Duplicate { member: i, first });
+        }
+        seen.insert((a.min(b), a.max(b)), i);
+    }
+    Ok(())
+}
+
+/// The diagonal of the bounding box of `points`, m (0 for none).
+pub fn bounding_diagonal(points: &[Vector3<Real>]) -> Real {
+    let mut lo = Vector3::repeat(Real::INFINITY);
+    let mut hi = Vector3::repeat(Real::NEG_INFINITY);
+    for p in points {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    if points.is_empty() {
+        0.0
+    } else {
+        (hi - lo).norm()
+    }
+}

@@ -1,0 +1,364 @@
+use crate::linkage::assembly::ModelTooLarge;
+use crate::linkage::cholesky::{CholeskyError, SparseCholesky};
+use crate::linkage::mechanism::{diagnose_mechanism, Mechanism};
+use crate::linkage::{
+    axial_stiffness, member_block, Body, BodyError, DofMap, DofSlot, Schedule, StiffnessAssembly,
+};
+use crate::Real;
+use nalgebra::Vector3;
+use std::time::Instant;
+
+/// The solved state of a body at one load step.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepState {
+    /// Displacement of every node, m.
+    pub displacements: Vec<Vector3<Real>>,
+    /// Axial force of every member, N, tension positive.
+    pub axial_forces: Vec<Real>,
+    /// Engineering strain of every member (change of length over length), tension positive.
+    pub strains: Vec<Real>,
+    /// Axial stress of every member, Pa, tension positive.
+    pub stresses: Vec<Real>,
+    /// Members (0-based) whose stress is beyond their material's strength.
+    pub overloaded: Vec<usize>,
+    /// Per supported node (0-based), the force the supports exert on the body, N (paper Eq. 10).
+    pub reactions: Vec<(usize, Vector3<Real>)>,
+    /// Per loaded node (0-based), the applied force at this step, N.
+    pub loads: Vec<(usize, Vector3<Real>)>,
+    /// Out-of-balance force at the free DOFs over the largest of applied force and reaction
+    /// norms (0 when nothing is loaded).
+    pub residual: Real,
+}
+
+/// Wall time of the phases of a linear solve, s.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhaseTimes {
+    /// Pattern construction and value fill of `K_ff`.
+    pub assembly: Real,
+    /// Fill-reducing ordering and symbolic factorization.
+    pub symbolic: Real,
+    /// Numeric Cholesky factorization.
+    pub numeric: Real,
+    /// Forward and back substitution (all load patterns).
+    pub solve: Real,
+}
+
+/// Why a body could not be solved.
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    /// The body fails validation.
+    #[error(transparent)]
+    Body(#[from] BodyError),
+    /// The body is too large for the 32-bit pattern positions.
+    #[error(transparent)]
+    TooLarge(#[from] ModelTooLarge),
+    /// `K_ff` is singular: some nodes can move without stretching any member.
+    #[error("{0}")]
+    Mechanism(Box<Mechanism>),
+    /// The factorization failed for another reason.
+    #[error("body '{body}': the sparse factorization failed: {message}")]
+    Factorization {
+        /// Body name.
+        body: String,
+        /// What faer reported.
+        message: String,
+    },
+    /// The solve returned a result that does not satisfy equilibrium.
+    #[error("body '{body}': the solution misses equilibrium by {residual:e} (relative): the stiffness matrix is too ill-conditioned (members of very different stiffness, or nearly collinear members); check the materials and the geometry")]
+    Inaccurate {
+        /// Body name.
+        body: String,
+        /// Relative out-of-balance force.
+        residual: Real,
+    },
+}
+
+/// The loads and prescribed displacements that share one schedule, and the displacement field
+/// they cause at full value: the linear model lets each step be a sum of these (superposition).
+#[derive(Clone, Debug)]
+struct LoadPattern {
+    schedule: Schedule,
+    /// Applied force per body DOF at full value, N.
+    forces: Vec<Real>,
+    /// Displacement per body DOF at full value, m: prescribed at supported DOFs, solved at free ones.
+    displacements: Vec<Real>,
+}
+
+/// The linear equilibrium of one body (paper Eq. 5–10): `K_ff` assembled and factored once,
+/// one solve per distinct load schedule, every step a weighted sum of those solutions.
+pub struct Equilibrium {
+    /// The free/support partition.
+    pub dofs: DofMap,
+    /// The pattern of `K_ff` and the place of each member entry.
+    pub assembly: StiffnessAssembly,
+    /// Values of `K_ff` (lower triangle, in the assembly's pattern), N/m.
+    pub values: Vec<Real>,
+    /// Time spent in each phase, s.
+    pub times: PhaseTimes,
+    /// Entries of the Cholesky factor (0 when nothing is free).
+    pub factor_entries: usize,
+    patterns: Vec<LoadPattern>,
+    stiffness: Vec<Real>,
+}
+
+impl Equilibrium {
+    /// Validate, assemble, factor and solve every load pattern of `body`.
+    pub fn new(body: &Body) -> Result<Self, SolveError> {
+        body.validate()?;
+        let t = Instant::now();
+        let dofs = DofMap::new(body);
+        let assembly = StiffnessAssembly::new(body, &dofs)?;
+        let stiffness: Vec<Real> = (0..body.members.len())
+            .map(|m| {
+                axial_stiffness(
+                    &body.materials[body.members[m].material],
+                    body.member_length(m),
+                )
+            })
+            .collect();
+        let mut values = Vec::new();
+        assembly.fill(
+            body,
+            |m| {
+                let [a, b] = body.members[m].nodes;
+                member_block(&body.nodes[a], &body.nodes[b], stiffness[m])
+            },
+            &mut values,
+        );
+        let times = PhaseTimes {
+            assembly: t.elapsed().as_secs_f64(),
+            ..Default::default()
+        };
+        let mut eq = Equilibrium {
+            dofs,
+            assembly,
+            values,
+            times,
+            factor_entries: 0,
+            patterns: Vec::new(),
+            stiffness,
+        };
+        let mut cholesky = None;
+        if eq.assembly.n > 0 {
+            let t = Instant::now();
+            let a = &eq.assembly;
+            let mut c = SparseCholesky::analyze(a.n, &a.col_ptr, &a.row_idx, Some(&a.groups))
+                .map_err(|e| eq.factorization_error(body, e))?;
+            eq.times.symbolic = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            if let Err(e) = c.factorize(&eq.values) {
+                return Err(eq.singular(body, &mut c, e));
+            }
+            eq.times.numeric = t.elapsed().as_secs_f64();
+            eq.factor_entries = c.stats().nnz_l;
+            cholesky = Some(c);
+        }
+        let t = Instant::now();
+        eq.patterns = eq.solve_patterns(body, cholesky.as_mut());
+        eq.times.solve = t.elapsed().as_secs_f64();
+        Ok(eq)
+    }
+
+    fn factorization_error(&self, body: &Body, e: CholeskyError) -> SolveError {
+        SolveError::Factorization {
+            body: body.name.clone(),
+            message: e.to_string(),
+        }
+    }
+
+    /// Turn a failed factorization into a mechanism report naming nodes and directions.
+    fn singular(&self, body: &Body, c: &mut SparseCholesky, e: CholeskyError) -> SolveError {
+        let pivot = match e {
+            CholeskyError::NonPositivePivot { dof } => dof,
+            CholeskyError::NearlySingular { dof, .. } => dof,
+            other => return self.factorization_error(body, other),
+        };
+        SolveError::Mechanism(Box::new(diagnose_mechanism(
+            body,
+            &self.dofs,
+            &self.assembly,
+            &self.values,
+            c,
+            pivot,
+        )))
+    }
+
+    /// Group loads and prescribed displacements by schedule and solve `K_ff U_f = F_f − K_fs U_s`
+    /// (paper Eq. 6 with non-zero `U_s`) once for each group.
+    fn solve_patterns(
+        &self,
+        body: &Body,
+        mut cholesky: Option<&mut SparseCholesky>,
+    ) -> Vec<LoadPattern> {
+        let nd = body.dof_count();
+        let d = self.dofs.dofs_per_node;
+        let mut patterns: Vec<LoadPattern> = Vec::new();
+        let pattern_of = |schedule: &Schedule, patterns: &mut Vec<LoadPattern>| -> usize {
+            if let Some(i) = patterns.iter().position(|p| &p.schedule == schedule) {
+                return i;
+            }
+            patterns.push(LoadPattern {
+                schedule: schedule.clone(),
+                forces: vec![0.0; nd],
+                displacements: vec![0.0; nd],
+            });
+            patterns.len() - 1
+        };
+        for l in &body.loads {
+            let p = pattern_of(&l.schedule, &mut patterns);
+            for dir in 0..d {
+                patterns[p].forces[l.node * d + dir] += l.force[dir];
+            }
+        }
+        for s in &body.supports {
+            if s.displacement == Vector3::zeros() {
+                continue;
+            }
+            let p = pattern_of(&s.schedule, &mut patterns);
+            for dir in 0..d {
+                if s.fixed[dir] {
+                    patterns[p].displacements[s.node * d + dir] = s.displacement[dir];
+                }
+            }
+        }
+        let mut rhs = vec![0.0; self.assembly.n];
+        let mut internal = vec![0.0; nd];
+        for p in &mut patterns {
+            // F_f − K_fs U_s: the internal force of the prescribed displacements alone.
+            self.internal_forces(body, &p.displacements, &mut internal);
+            for (i, &dof) in self.dofs.free.iter().enumerate() {
+                rhs[i] = p.forces[dof] - internal[dof];
+            }
+            if let Some(c) = cholesky.as_deref_mut() {
+                c.solve_in_place(&mut rhs);
+            }
+            for (i, &dof) in self.dofs.free.iter().enumerate() {
+                p.displacements[dof] = rhs[i];
+            }
+        }
+        patterns
+    }
+
+    /// `K u` for a displacement per body DOF, summed member by member, N.
+    fn internal_forces(&self, body: &Body, u: &[Real], out: &mut [Real]) {
+        let d = self.dofs.dofs_per_node;
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for (m, member) in body.members.iter().enumerate() {
+            let [a, b] = member.nodes;
+            let n = axis(body, a, b);
+            let stretch: Real = (0..d).map(|k| n[k] * (u[b * d + k] - u[a * d + k])).sum();
+            let force = self.stiffness[m] * stretch;
+            for k in 0..d {
+                out[a * d + k] -= force * n[k];
+                out[b * d + k] += force * n[k];
+            }
+        }
+    }
+
+    /// The state at `step` of `steps` (step 0: undeformed, unloaded).
+    pub fn solve_step(
+        &self,
+        body: &Body,
+        step: usize,
+        steps: usize,
+    ) -> Result<StepState, SolveError> {
+        let nd = body.dof_count();
+        let d = self.dofs.dofs_per_node;
+        let mut u = vec![0.0; nd];
+        let mut forces = vec![0.0; nd];
+        for p in &self.patterns {
+            let f = p.schedule.factor(step, steps);
+            if f == 0.0 {
+                continue;
+            }
+            for i in 0..nd {
+                u[i] += f * p.displacements[i];
+                forces[i] += f * p.forces[i];
+            }
+        }
+        let mut state = StepState {
+            displacements: (0..body.nodes.len())
+                .map(|i| {
+                    let mut v = Vector3::zeros();
+                    for k in 0..d {
+                        v[k] = u[i * d + k];
+                    }
+                    v
+                })
+                .collect(),
+            ..Default::default()
+        };
+        for (m, member) in body.members.iter().enumerate() {
+            let [a, b] = member.nodes;
+            let n = axis(body, a, b);
+            let length = body.member_length(m);
+            let strain = n.dot(&(state.displacements[b] - state.displacements[a])) / length;
+            let material = &body.materials[member.material];
+            let stress = material.youngs_modulus * strain;
+            state.strains.push(strain);
+            state.stresses.push(stress);
+            state.axial_forces.push(stress * material.area);
+            if material.is_overloaded(stress) {
+                state.overloaded.push(m);
+            }
+        }
+        let mut internal = vec![0.0; nd];
+        self.internal_forces(body, &u, &mut internal);
+        let mut supported_node = vec![false; body.nodes.len()];
+        for &dof in &self.dofs.supported {
+            supported_node[dof / d] = true;
+        }
+        for (node, _) in supported_node.iter().enumerate().filter(|(_, s)| **s) {
+            let mut r = Vector3::zeros();
+            for k in 0..d {
+                if let DofSlot::Supported(_) = self.dofs.slots[node * d + k] {
+                    r[k] = internal[node * d + k] - forces[node * d + k];
+                }
+            }
+            state.reactions.push((node, r));
+        }
+        let mut loaded = vec![false; body.nodes.len()];
+        for l in &body.loads {
+            loaded[l.node] = true;
+        }
+        for (node, _) in loaded.iter().enumerate().filter(|(_, l)| **l) {
+            let mut f = Vector3::zeros();
+            for k in 0..d {
+                f[k] = forces[node * d + k];
+            }
+            state.loads.push((node, f));
+        }
+        let out_of_balance: Real = self
+            .dofs
+            .free
+            .iter()
+            .map(|&dof| (internal[dof] - forces[dof]).powi(2))
+            .sum::<Real>()
+            .sqrt();
+        let applied = forces.iter().map(|f| f * f).sum::<Real>().sqrt();
+        let reacted = state
+            .reactions
+            .iter()
+            .map(|(_, r)| r.norm_squared())
+            .sum::<Real>()
+            .sqrt();
+        let scale = applied.max(reacted);
+        state.residual = if scale > 0.0 {
+            out_of_balance / scale
+        } else {
+            0.0
+        };
+        if !state.residual.is_finite() || state.residual > 1e-6 {
+            return Err(SolveError::Inaccurate {
+                body: body.name.clone(),
+                residual: state.residual,
+            });
+        }
+        Ok(state)
+    }
+}
+
+/// Unit vector from node `a` to node `b` in the undeformed body.
+fn axis(body: &Body, a: usize, b: usize) -> Vector3<Real> {
+    (body.nodes[b] - body.nodes[a]).normalize()
+}

@@ -1,0 +1,99 @@
+use crate::Real;
+
+/// The material and cross-section of a member: what the paper's `AE` is made of.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name used by scene files and links files to refer to it.
+    pub name: String,
+    /// Young's modulus E, Pa.
+    pub youngs_modulus: Real,
+    /// Cross-section area A, m².
+    pub area: Real,
+    /// Largest tensile stress before the member counts as overloaded, Pa (none: no limit).
+    pub tensile_strength: Option<Real>,
+    /// Largest compressive stress (given as a positive number), Pa (none: no limit).
+    pub compressive_strength: Option<Real>,
+}
+
+impl Material {
+    /// A material without strength limits.
+    pub fn new(name: &str, youngs_modulus: Real, area: Real) -> Self {
+        Material {
+            name: name.to_string(),
+            youngs_modulus,
+            area,
+            tensile_strength: None,
+            compressive_strength: None,
+        }
+    }
+
+    /// Whether a member of this material at `stress` (Pa, tension positive) is beyond its strength.
+    pub fn is_overloaded(&self, stress: Real) -> bool {
+        match (self.tensile_strength, self.compressive_strength) {
+            (Some(t), _) if stress > t => true,
+            (_, Some(c)) if stress < -c => true,
+            _ => false,
+        }
+    }
+
+    /// Why this material cannot be used, if it cannot: E and A must be finite and positive,
+    /// strengths finite and positive when given.
+    pub fn problem(&self) -> Option<String> {
+        let positive = |v: Real| v.is_finite() && v > 0.0;
+        if !positive(self.youngs_modulus) {
+            return Some(format!(
+                "youngs_modulus = {} must be a finite positive number of Pa",
+                self.youngs_modulus
+            ));
+        }
+        if !positive(self.area) {
+            return Some(format!(
+                "area = {} must be a finite positive number of m²",
+                self.area
+            ));
+        }
+        for (key, v) in [
+            ("tensile_strength", self.tensile_strength),
+            ("compressive_strength", self.compressive_strength),
+        ] {
+            if let Some(v) = v {
+                if !positive(v) {
+                    return Some(format!(
+                        "{key} = {v} must be a finite positive number of Pa"
+                    ));
+                }
+            }
+        }
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overload_respects_sign_and_limits() {
+        let mut m = Material::new("s", 1.0, 1.0);
+        assert!(!m.is_overloaded(1e30));
+        m.tensile_strength = Some(10.0);
+        m.compressive_strength = Some(5.0);
+        assert!(m.is_overloaded(10.5));
+        assert!(!m.is_overloaded(10.0));
+        assert!(!m.is_overloaded(-5.0));
+        assert!(m.is_overloaded(-5.5));
+    }
+
+    #[test]
+    fn bad_values_are_named() {
+        assert!(Material::new("s", 0.0, 1.0)
+            .problem()
+            .unwrap()
+            .contains("youngs_modulus"));
+        assert!(Material::new("s", 1.0, Real::NAN)
+            .problem()
+            .unwrap()
+            .contains("area"));
+        assert!(Material::new("s", 1.0, 1.0).problem().is_none());
+    }
+}

@@ -1,0 +1,360 @@
+//! From a scene file to a checked [`World`]: every problem is reported with the file and line.
+
+use crate::linkage::generators;
+use crate::linkage::paper_files::{self, PaperFileError};
+use crate::linkage::{Body, Dimension, Geometry, Material, Member, NodalLoad, Schedule, Support};
+use crate::scene::selector::{select_nodes, vector};
+use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
+use crate::scene::{OutputSettings, World};
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// Why a scene cannot be built. Every variant names the file; most name the line.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The scene file cannot be read.
+    #[error("{path}: cannot read the scene file: {source}")]
+    Read {
+        /// Scene file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// TOML syntax, an unknown key or a wrong type (the message has line and column).
+    #[error("{path}: {message}")]
+    Parse {
+        /// Scene file.
+        path: PathBuf,
+        /// toml's message.
+        message: String,
+    },
+    /// A value that is the right type but cannot be used.
+    #[error("{path}:{line}: {message}")]
+    At {
+        /// Scene file.
+        path: PathBuf,
+        /// 1-based line of the entry.
+        line: usize,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// A problem in one of the paper's files a body reads.
+    #[error(transparent)]
+    PaperFile(#[from] PaperFileError),
+}
+
+/// Read, parse and check a scene file.
+pub fn load_scene(path: &Path) -> Result<World, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    build_world(&text, path)
+}
+
+/// Parse and check scene `text` that was read from `path` (relative file names resolve
+/// against its folder).
+pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
+    let spec: SceneSpec = toml::from_str(text).map_err(|e| SceneError::Parse {
+        path: path.to_path_buf(),
+        message: e.to_string().trim_end().to_string(),
+    })?;
+    let at = |span: std::ops::Range<usize>, message: String| SceneError::At {
+        path: path.to_path_buf(),
+        line: text[..span.start.min(text.len())].matches('\n').count() + 1,
+        message,
+    };
+    let top = 0..0;
+    if spec.name.is_empty()
+        || spec.name.starts_with('.')
+        || !spec
+            .name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c))
+    {
+        return Err(at(
+            top,
+            format!(
+                "name = {:?} names the output folder: use letters, digits, '_', '-' and '.' (not first)",
+                spec.name
+            ),
+        ));
+    }
+    if spec.steps == 0 {
+        return Err(at(
+            top,
+            "steps = 0: a scene needs at least 1 load step".to_string(),
+        ));
+    }
+    let output = OutputSettings {
+        every: match spec.output.every {
+            Some(0) => return Err(at(top, "[output] every = 0: give 1 or more".to_string())),
+            Some(k) => k,
+            None => 1,
+        },
+        last_only: spec.output.last_only,
+    };
+
+    let mut materials = Vec::new();
+    for m in &spec.materials {
+        let material = material_from(m.get_ref()).map_err(|e| at(m.span(), e))?;
+        if materials.iter().any(|o: &Material| o.name == material.name) {
+            return Err(at(
+                m.span(),
+                format!("material '{}' is defined twice", material.name),
+            ));
+        }
+        materials.push(material);
+    }
+    if spec.bodies.is_empty() {
+        return Err(at(
+            top,
+            "the scene has no [[bodies]]: add at least one".to_string(),
+        ));
+    }
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let mut bodies: Vec<Body> = Vec::new();
+    for b in &spec.bodies {
+        let body = build_body(b, &materials, folder, spec.steps, &at)?;
+        if bodies.iter().any(|o| o.name == body.name) {
+            return Err(at(
+                b.span(),
+                format!(
+                    "body '{}' is defined twice: body names must differ",
+                    body.name
+                ),
+            ));
+        }
+        body.validate().map_err(|e| at(b.span(), e.to_string()))?;
+        bodies.push(body);
+    }
+    Ok(World {
+        name: spec.name,
+        steps: spec.steps,
+        bodies,
+        output,
+        source: path.to_path_buf(),
+    })
+}
+
+fn material_from(m: &MaterialSpec) -> Result<Material, String> {
+    let material = Material {
+        name: m.name.clone(),
+        youngs_modulus: m.youngs_modulus,
+        area: m.area,
+        tensile_strength: m.tensile_strength.or(m.strength),
+        compressive_strength: m.compressive_strength.or(m.strength),
+    };
+    match material.problem() {
+        Some(p) => Err(format!("material '{}': {p}", m.name)),
+        None => Ok(material),
+    }
+}
+
+fn build_body(
+    spanned: &Spanned<BodySpec>,
+    materials: &[Material],
+    folder: &Path,
+    steps: usize,
+    at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
+) -> Result<Body, SceneError> {
+    let spec = spanned.get_ref();
+    let here = |message: String| at(spanned.span(), format!("body '{}': {message}", spec.name));
+    match spec.kinematics.as_deref() {
+        None | Some("linear") => {}
+        Some(other) => {
+            return Err(here(format!(
+                "kinematics = {other:?} is not available: use \"linear\" (the paper's model)"
+            )))
+        }
+    }
+    match spec.solver.as_deref() {
+        None | Some("direct") | Some("auto") => {}
+        Some(other) => {
+            return Err(here(format!(
+                "solver = {other:?} is not available: use \"direct\" or \"auto\""
+            )))
+        }
+    }
+    let material_index = |name: &str| materials.iter().position(|m| m.name == name);
+    let default_material = match &spec.material {
+        Some(name) => Some(material_index(name).ok_or_else(|| {
+            here(format!(
+                "material '{name}' is not defined: add a [[materials]] entry named '{name}'"
+            ))
+        })?),
+        None if materials.len() == 1 => Some(0),
+        None => None,
+    };
+    let need_default = || {
+        here(if materials.is_empty() {
+            "no material: add a [[materials]] entry and name it with `material =`".to_string()
+        } else {
+            "give `material = \"...\"`: the scene has several materials".to_string()
+        })
+    };
+
+    let generated = [
+        spec.disk.is_some(),
+        spec.rectangle.is_some(),
+        spec.cylindrical_shell.is_some(),
+        spec.box_lattice.is_some(),
+    ]
+    .iter()
+    .filter(|g| **g)
+    .count();
+    let from_files = spec.nodes.is_some() || spec.links.is_some();
+    if generated + usize::from(from_files) != 1 {
+        return Err(here(
+            "give the geometry either as files (`nodes` and `links`, optionally `patches`) or as exactly one generator (`disk`, `rectangle`, `cylindrical_shell`, `box_lattice`)".to_string(),
+        ));
+    }
+    let mut body = Body::new(&spec.name, Dimension::Two);
+    body.materials = materials.to_vec();
+    if from_files {
+        let (Some(nodes_file), Some(links_file)) = (&spec.nodes, &spec.links) else {
+            return Err(here(
+                "a body read from files needs both `nodes` and `links`".to_string(),
+            ));
+        };
+        let (dimension, nodes) = paper_files::read_nodes(&folder.join(nodes_file))?;
+        let links = paper_files::read_links(&folder.join(links_file), &nodes)?;
+        for link in &links {
+            let material = match &link.material {
+                Some(name) => material_index(name).ok_or_else(|| {
+                    SceneError::PaperFile(PaperFileError::Line {
+                        path: folder.join(links_file),
+                        line: link.line,
+                        message: format!(
+                            "material '{name}' is not defined in the scene: add a [[materials]] entry named '{name}'"
+                        ),
+                    })
+                })?,
+                None => default_material.ok_or_else(need_default)?,
+            };
+            body.members.push(Member {
+                nodes: link.nodes,
+                material,
+            });
+        }
+        if let Some(patches_file) = &spec.patches {
+            body.patches = paper_files::read_patches(&folder.join(patches_file), nodes.len())?;
+        }
+        body.dimension = dimension;
+        body.nodes = nodes;
+    } else {
+        if spec.patches.is_some() {
+            return Err(here(
+                "`patches` goes with `nodes` and `links` files, not with a generator".to_string(),
+            ));
+        }
+        let geometry: Geometry = if let Some(g) = &spec.disk {
+            generators::disk(g.radius, g.rings, g.sectors)
+        } else if let Some(g) = &spec.rectangle {
+            generators::rectangle(g.width, g.height, g.cells[0], g.cells[1])
+        } else if let Some(g) = &spec.cylindrical_shell {
+            generators::cylindrical_shell(g.radius, g.length, g.rings, g.sectors)
+        } else if let Some(g) = &spec.box_lattice {
+            generators::box_lattice(g.size, g.cells)
+        } else {
+            unreachable!("exactly one generator was counted above")
+        }
+        .map_err(|e| here(e.to_string()))?;
+        let material = default_material.ok_or_else(need_default)?;
+        body.dimension = geometry.dimension;
+        body.nodes = geometry.nodes;
+        body.members = geometry
+            .members
+            .into_iter()
+            .map(|nodes| Member { nodes, material })
+            .collect();
+        body.patches = geometry.patches;
+    }
+    if body.dimension == Dimension::Two && !body.patches.is_empty() {
+        return Err(here(
+            "patches are for 3D bodies; this body's nodes have 2 coordinates".to_string(),
+        ));
+    }
+
+    let schedule = |s: &Option<Vec<f64>>| -> Result<Schedule, String> {
+        match s {
+            None => Ok(Schedule::Linear),
+            Some(f) if f.len() != steps => Err(format!(
+                "schedule has {} factors but the scene has {steps} steps: give one factor per step",
+                f.len()
+            )),
+            Some(f) => Ok(Schedule::Factors(f.clone())),
+        }
+    };
+    let d = body.dimension.dofs_per_node();
+    for s in &spec.supports {
+        let sp = s.get_ref();
+        let fail = |m: String| at(s.span(), format!("body '{}': support: {m}", spec.name));
+        let nodes = select_nodes(&sp.selector(), &body).map_err(fail)?;
+        if sp.fix.is_empty() {
+            return Err(fail(
+                "`fix` is empty: list the held directions, e.g. fix = [\"x\", \"y\"]".to_string(),
+            ));
+        }
+        let mut fixed = [false; 3];
+        for dir in &sp.fix {
+            let k = match dir.as_str() {
+                "x" => 0,
+                "y" => 1,
+                "z" if d == 3 => 2,
+                "z" => return Err(fail("`fix` names \"z\" but the body is 2D".to_string())),
+                other => {
+                    return Err(fail(format!(
+                        "`fix` names {other:?}: use \"x\", \"y\" or \"z\""
+                    )))
+                }
+            };
+            fixed[k] = true;
+        }
+        let displacement = match &sp.displacement {
+            Some(v) => vector(v, body.dimension, "displacement").map_err(fail)?,
+            None => nalgebra::Vector3::zeros(),
+        };
+        if let Some(k) = (0..3).find(|&k| !fixed[k] && displacement[k] != 0.0) {
+            return Err(fail(format!(
+                "`displacement` is non-zero in direction {} which is not in `fix`",
+                ["x", "y", "z"][k]
+            )));
+        }
+        let schedule = schedule(&sp.schedule).map_err(fail)?;
+        for node in nodes {
+            body.supports.push(Support {
+                node,
+                fixed,
+                displacement,
+                schedule: schedule.clone(),
+            });
+        }
+    }
+    for l in &spec.loads {
+        let lp = l.get_ref();
+        let fail = |m: String| at(l.span(), format!("body '{}': load: {m}", spec.name));
+        let nodes = select_nodes(&lp.selector(), &body).map_err(fail)?;
+        let force = match (&lp.force, &lp.total_force) {
+            (Some(f), None) => vector(f, body.dimension, "force").map_err(fail)?,
+            (None, Some(f)) => {
+                vector(f, body.dimension, "total_force").map_err(fail)? / nodes.len() as f64
+            }
+            _ => {
+                return Err(fail(
+                    "give exactly one of `force` (per node) and `total_force` (shared), in N"
+                        .to_string(),
+                ))
+            }
+        };
+        let schedule = schedule(&lp.schedule).map_err(fail)?;
+        for node in nodes {
+            body.loads.push(NodalLoad {
+                node,
+                force,
+                schedule: schedule.clone(),
+            });
+        }
+    }
+    Ok(body)
+}

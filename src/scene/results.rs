@@ -1,0 +1,173 @@
+//! The result files of a run (`summary.json`, `steps/NNNN.json`): see the README's output section.
+
+use crate::linkage::{Body, StepState};
+use crate::Real;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// A force at a node, as written: 1-based node, one component per dimension, N.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NodeForce {
+    /// 1-based node number.
+    pub node: usize,
+    /// Force, N.
+    pub force: Vec<Real>,
+}
+
+/// A node pressing on another body or an obstacle (filled by contact; empty without).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactForce {
+    /// 1-based node number.
+    pub node: usize,
+    /// Name of the body or obstacle touched.
+    pub with: String,
+    /// Penetration depth, m.
+    pub depth: Real,
+    /// Force the node receives, N.
+    pub force: Vec<Real>,
+}
+
+/// One body at one step, as written in `steps/NNNN.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BodyResult {
+    /// Body name.
+    pub name: String,
+    /// Displacement per node, m.
+    pub displacements: Vec<Vec<Real>>,
+    /// Deformed position per node, m.
+    pub positions: Vec<Vec<Real>>,
+    /// Axial force per member, N, tension positive.
+    pub axial_forces: Vec<Real>,
+    /// Strain per member (change of length over length), tension positive.
+    pub strains: Vec<Real>,
+    /// Stress per member, Pa, tension positive.
+    pub stresses: Vec<Real>,
+    /// 1-based numbers of the members beyond their strength.
+    pub overloaded: Vec<usize>,
+    /// Force each supported node receives from its supports, N.
+    pub reactions: Vec<NodeForce>,
+    /// Applied force per loaded node at this step, N.
+    pub loads: Vec<NodeForce>,
+    /// Contact forces per node.
+    pub contacts: Vec<ContactForce>,
+}
+
+/// One stored step: `steps/NNNN.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepResult {
+    /// Step number (0: undeformed).
+    pub step: usize,
+    /// Load factor of the step.
+    pub load_factor: Real,
+    /// Every body of the scene, in scene order.
+    pub bodies: Vec<BodyResult>,
+}
+
+/// One line of `summary.json`'s `steps`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepSummary {
+    /// Step number.
+    pub step: usize,
+    /// Load factor.
+    pub load_factor: Real,
+    /// Equilibrium iterations (a linear step is one).
+    pub iterations: usize,
+    /// Contact iterations (0 without contact).
+    pub contact_iterations: usize,
+    /// Relative out-of-balance force, largest over the bodies.
+    pub residual: Real,
+    /// Largest node displacement, m.
+    pub max_displacement: Real,
+    /// Overloaded members, all bodies.
+    pub overloaded: usize,
+    /// Largest penetration, m (0 without contact).
+    pub max_penetration: Real,
+    /// Wall time of the step, s (step 1 includes assembly and factorization).
+    pub seconds: Real,
+}
+
+/// Size of one body, as reported in `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BodySize {
+    /// Body name.
+    pub name: String,
+    /// 2 or 3.
+    pub dimension: usize,
+    /// Nodes.
+    pub nodes: usize,
+    /// Members.
+    pub members: usize,
+    /// Surface patches.
+    pub patches: usize,
+    /// Free DOFs (size of `K_ff`).
+    pub free_dofs: usize,
+}
+
+/// Wall time of the run's phases, s, summed over bodies.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PhaseSeconds {
+    /// Assembly of `K_ff`.
+    pub assembly: Real,
+    /// Ordering and symbolic factorization.
+    pub symbolic: Real,
+    /// Numeric factorization.
+    pub numeric: Real,
+    /// Triangular solves.
+    pub solve: Real,
+    /// Writing result files.
+    pub writing: Real,
+}
+
+/// `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Scene name.
+    pub scene: String,
+    /// Per step, 0..=steps.
+    pub steps: Vec<StepSummary>,
+    /// Model sizes.
+    pub bodies: Vec<BodySize>,
+    /// Where the time went.
+    pub phases: PhaseSeconds,
+}
+
+/// Components of a vector for a body of dimension `d` (2 or 3).
+fn components(v: &Vector3<Real>, d: usize) -> Vec<Real> {
+    v.as_slice()[..d].to_vec()
+}
+
+impl BodyResult {
+    /// The written form of `state` for `body`.
+    pub fn new(body: &Body, state: &StepState) -> Self {
+        let d = body.dimension.dofs_per_node();
+        let node_forces = |list: &[(usize, Vector3<Real>)]| {
+            list.iter()
+                .map(|(n, f)| NodeForce {
+                    node: n + 1,
+                    force: components(f, d),
+                })
+                .collect()
+        };
+        BodyResult {
+            name: body.name.clone(),
+            displacements: state
+                .displacements
+                .iter()
+                .map(|u| components(u, d))
+                .collect(),
+            positions: body
+                .nodes
+                .iter()
+                .zip(&state.displacements)
+                .map(|(p, u)| components(&(p + u), d))
+                .collect(),
+            axial_forces: state.axial_forces.clone(),
+            strains: state.strains.clone(),
+            stresses: state.stresses.clone(),
+            overloaded: state.overloaded.iter().map(|m| m + 1).collect(),
+            reactions: node_forces(&state.reactions),
+            loads: node_forces(&state.loads),
+            contacts: Vec::new(),
+        }
+    }
+}

@@ -1,0 +1,142 @@
+//! Choosing nodes of a body by number or by geometry.
+
+use crate::linkage::{Body, Dimension};
+use crate::scene::spec::SelectorSpec;
+use crate::Real;
+use nalgebra::Vector3;
+
+/// The nodes (0-based) a selector picks, or why it cannot pick any. Messages are for users:
+/// they say what was asked and what to change.
+pub fn select_nodes(spec: &SelectorSpec, body: &Body) -> Result<Vec<usize>, String> {
+    let given = [
+        spec.nodes.is_some(),
+        spec.nearest.is_some(),
+        spec.inside.is_some(),
+        spec.on_line.is_some(),
+        spec.on_plane.is_some(),
+    ]
+    .iter()
+    .filter(|g| **g)
+    .count();
+    if given != 1 {
+        return Err(format!(
+            "give exactly one of `nodes`, `nearest`, `inside`, `on_line`, `on_plane` to choose the nodes ({given} given)"
+        ));
+    }
+    let tolerance = match spec.tolerance {
+        Some(t) if t.is_finite() && t >= 0.0 => t,
+        Some(t) => {
+            return Err(format!(
+                "tolerance = {t} must be a finite non-negative number of metres"
+            ))
+        }
+        None => 1e-6 * body.size(),
+    };
+    let count = body.nodes.len();
+    if let Some(list) = &spec.nodes {
+        if list.is_empty() {
+            return Err("`nodes` is empty: list at least one node number".to_string());
+        }
+        return list
+            .iter()
+            .map(|&n| {
+                if n >= 1 && (n as usize) <= count {
+                    Ok(n as usize - 1)
+                } else {
+                    Err(format!(
+                        "node {n} does not exist: body '{}' has nodes 1 to {count}",
+                        body.name
+                    ))
+                }
+            })
+            .collect();
+    }
+    let point = |v: &[Real], key: &str| vector(v, body.dimension, key);
+    let picked: Vec<usize> = if let Some(p) = &spec.nearest {
+        let p = point(p, "nearest")?;
+        let best = (0..count).min_by(|&a, &b| {
+            (body.nodes[a] - p)
+                .norm_squared()
+                .total_cmp(&(body.nodes[b] - p).norm_squared())
+        });
+        best.into_iter().collect()
+    } else if let Some(b) = &spec.inside {
+        let lo = point(&b.min, "inside.min")?;
+        let hi = point(&b.max, "inside.max")?;
+        if (0..3).any(|k| lo[k] > hi[k]) {
+            return Err("inside.min must not exceed inside.max in any direction".to_string());
+        }
+        (0..count)
+            .filter(|&i| {
+                let q = body.nodes[i];
+                (0..3).all(|k| q[k] >= lo[k] - tolerance && q[k] <= hi[k] + tolerance)
+            })
+            .collect()
+    } else if let Some(l) = &spec.on_line {
+        let p = point(&l.point, "on_line.point")?;
+        let d = unit(
+            point(&l.direction, "on_line.direction")?,
+            "on_line.direction",
+        )?;
+        (0..count)
+            .filter(|&i| {
+                let r = body.nodes[i] - p;
+                (r - d * d.dot(&r)).norm() <= tolerance
+            })
+            .collect()
+    } else if let Some(pl) = &spec.on_plane {
+        let p = point(&pl.point, "on_plane.point")?;
+        let n = unit(point(&pl.normal, "on_plane.normal")?, "on_plane.normal")?;
+        (0..count)
+            .filter(|&i| n.dot(&(body.nodes[i] - p)).abs() <= tolerance)
+            .collect()
+    } else {
+        Vec::new()
+    };
+    if picked.is_empty() {
+        return Err(format!(
+            "the selector matches no node of body '{}' (tolerance {tolerance:e} m): check its coordinates against the body, which spans {}",
+            body.name,
+            extent(body)
+        ));
+    }
+    Ok(picked)
+}
+
+/// A point or direction with one component per dimension of the body, as a 3-vector.
+pub fn vector(v: &[Real], dimension: Dimension, key: &str) -> Result<Vector3<Real>, String> {
+    let d = dimension.dofs_per_node();
+    if v.len() != d {
+        return Err(format!(
+            "`{key}` has {} components but the body is {}D: give {d}",
+            v.len(),
+            d
+        ));
+    }
+    if let Some(x) = v.iter().find(|x| !x.is_finite()) {
+        return Err(format!("`{key}` has the non-finite component {x}"));
+    }
+    let mut out = Vector3::zeros();
+    out.as_mut_slice()[..d].copy_from_slice(v);
+    Ok(out)
+}
+
+fn unit(v: Vector3<Real>, key: &str) -> Result<Vector3<Real>, String> {
+    let n = v.norm();
+    if n > 0.0 {
+        Ok(v / n)
+    } else {
+        Err(format!("`{key}` must not be the zero vector"))
+    }
+}
+
+fn extent(body: &Body) -> String {
+    let mut lo = Vector3::repeat(Real::INFINITY);
+    let mut hi = Vector3::repeat(Real::NEG_INFINITY);
+    for p in &body.nodes {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let d = body.dimension.dofs_per_node();
+    format!("{:?} to {:?} m", &lo.as_slice()[..d], &hi.as_slice()[..d])
+}

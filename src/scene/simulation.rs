@@ -1,0 +1,192 @@
+//! The load-step driver: solve every body at every step and write the results.
+
+use crate::atomic_file::write_atomically;
+use crate::linkage::{Equilibrium, SolveError};
+use crate::scene::results::{BodyResult, BodySize, PhaseSeconds, StepResult, StepSummary, Summary};
+use crate::scene::World;
+use crate::Real;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// A world ready to step: each body's stiffness assembled and factored once.
+pub struct Simulation<'w> {
+    /// The scene being run.
+    pub world: &'w World,
+    /// One linear equilibrium per body, in scene order.
+    pub equilibria: Vec<Equilibrium>,
+}
+
+/// Why a run stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// A body could not be solved.
+    #[error("{scene}: {source}")]
+    Solve {
+        /// Scene file.
+        scene: PathBuf,
+        /// What went wrong.
+        source: SolveError,
+    },
+    /// A result file could not be written.
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        /// File or folder.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+impl<'w> Simulation<'w> {
+    /// Assemble and factor every body of `world`.
+    pub fn new(world: &'w World) -> Result<Self, RunError> {
+        let equilibria = world
+            .bodies
+            .iter()
+            .map(Equilibrium::new)
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|source| RunError::Solve {
+                scene: world.source.clone(),
+                source,
+            })?;
+        Ok(Simulation { world, equilibria })
+    }
+
+    /// The result of `step` (0..=steps) and its summary line (without the time).
+    pub fn step(&self, step: usize) -> Result<(StepResult, StepSummary), RunError> {
+        let world = self.world;
+        let mut result = StepResult {
+            step,
+            load_factor: world.load_factor(step),
+            bodies: Vec::with_capacity(world.bodies.len()),
+        };
+        let mut summary = StepSummary {
+            step,
+            load_factor: result.load_factor,
+            iterations: usize::from(step > 0),
+            contact_iterations: 0,
+            residual: 0.0,
+            max_displacement: 0.0,
+            overloaded: 0,
+            max_penetration: 0.0,
+            seconds: 0.0,
+        };
+        for (body, eq) in world.bodies.iter().zip(&self.equilibria) {
+            let state =
+                eq.solve_step(body, step, world.steps)
+                    .map_err(|source| RunError::Solve {
+                        scene: world.source.clone(),
+                        source,
+                    })?;
+            summary.residual = summary.residual.max(state.residual);
+            summary.overloaded += state.overloaded.len();
+            summary.max_displacement = state
+                .displacements
+                .iter()
+                .map(|u| u.norm())
+                .fold(summary.max_displacement, Real::max);
+            result.bodies.push(BodyResult::new(body, &state));
+        }
+        Ok((result, summary))
+    }
+
+    /// Model sizes for the summary.
+    pub fn sizes(&self) -> Vec<BodySize> {
+        self.world
+            .bodies
+            .iter()
+            .zip(&self.equilibria)
+            .map(|(b, eq)| BodySize {
+                name: b.name.clone(),
+                dimension: b.dimension.dofs_per_node(),
+                nodes: b.nodes.len(),
+                members: b.members.len(),
+                patches: b.patches.len(),
+                free_dofs: eq.assembly.n,
+            })
+            .collect()
+    }
+}
+
+/// Run `world` and write `out/<name>/` (summary.json and steps/NNNN.json). The folder is
+/// built under a temporary name and renamed when complete, so an interrupted or failed run
+/// leaves no partial results (and an earlier complete run stays until replaced).
+/// `on_step` is called after each solved step (for progress bars).
+pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Summary, RunError> {
+    let write_err = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| RunError::Write { path, source }
+    };
+    let final_dir = out.join(&world.name);
+    let staging = out.join(format!(".{}.partial-{}", world.name, std::process::id()));
+    let result = (|| {
+        let started = Instant::now();
+        let simulation = Simulation::new(world)?;
+        let setup = started.elapsed().as_secs_f64();
+        if staging.exists() {
+            std::fs::remove_dir_all(&staging).map_err(write_err(&staging))?;
+        }
+        let steps_dir = staging.join("steps");
+        std::fs::create_dir_all(&steps_dir).map_err(write_err(&steps_dir))?;
+        let mut phases = PhaseSeconds::default();
+        for eq in &simulation.equilibria {
+            phases.assembly += eq.times.assembly;
+            phases.symbolic += eq.times.symbolic;
+            phases.numeric += eq.times.numeric;
+            phases.solve += eq.times.solve;
+        }
+        let mut summary = Summary {
+            scene: world.name.clone(),
+            steps: Vec::with_capacity(world.steps + 1),
+            bodies: simulation.sizes(),
+            phases,
+        };
+        for step in 0..=world.steps {
+            let t = Instant::now();
+            let (result, mut line) = simulation.step(step)?;
+            line.seconds = t.elapsed().as_secs_f64() + if step == 1 { setup } else { 0.0 };
+            if world.output.writes(step, world.steps) {
+                let t = Instant::now();
+                let path = steps_dir.join(format!("{step:04}.json"));
+                let bytes = serde_json::to_vec(&result).map_err(|e| RunError::Write {
+                    path: path.clone(),
+                    source: e.into(),
+                })?;
+                write_atomically(&path, &bytes).map_err(write_err(&path))?;
+                summary.phases.writing += t.elapsed().as_secs_f64();
+            }
+            summary.steps.push(line);
+            on_step();
+        }
+        let path = staging.join("summary.json");
+        let bytes = serde_json::to_vec_pretty(&summary).map_err(|e| RunError::Write {
+            path: path.clone(),
+            source: e.into(),
+        })?;
+        write_atomically(&path, &bytes).map_err(write_err(&path))?;
+        replace_dir(&staging, &final_dir).map_err(write_err(&final_dir))?;
+        Ok(summary)
+    })();
+    if result.is_err() && staging.exists() {
+        let _ = std::fs::remove_dir_all(&staging);
+    }
+    result
+}
+
+/// Put the complete folder `from` at `to`, replacing an earlier one.
+fn replace_dir(from: &Path, to: &Path) -> std::io::Result<()> {
+    if to.exists() {
+        let old = to.with_file_name(format!(
+            ".{}.old-{}",
+            to.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            std::process::id()
+        ));
+        std::fs::rename(to, &old)?;
+        std::fs::rename(from, to)?;
+        std::fs::remove_dir_all(&old)
+    } else {
+        std::fs::rename(from, to)
+    }
+}

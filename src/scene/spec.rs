@@ -1,0 +1,263 @@
+//! The scene file as written (TOML), before any checking beyond types: see `docs/SCENES.md`.
+
+use crate::Real;
+use serde::Deserialize;
+use toml::Spanned;
+
+/// A whole scene file. Unknown keys are errors.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    /// Names the output folder `DIR/<name>/`.
+    pub name: String,
+    /// Number of load steps (≥ 1); loads reach full value at the last one.
+    #[serde(default = "one")]
+    pub steps: usize,
+    /// Materials the bodies refer to by name.
+    #[serde(default)]
+    pub materials: Vec<Spanned<MaterialSpec>>,
+    /// The deformable bodies.
+    #[serde(default)]
+    pub bodies: Vec<Spanned<BodySpec>>,
+    /// Which steps to write.
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// `[[materials]]`: E, A and optional strengths.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Name referred to by bodies and links files.
+    pub name: String,
+    /// Young's modulus E, Pa.
+    pub youngs_modulus: Real,
+    /// Cross-section area A, m².
+    pub area: Real,
+    /// Strength in tension and compression, Pa.
+    pub strength: Option<Real>,
+    /// Strength in tension, Pa (overrides `strength`).
+    pub tensile_strength: Option<Real>,
+    /// Strength in compression as a positive number, Pa (overrides `strength`).
+    pub compressive_strength: Option<Real>,
+}
+
+/// `[[bodies]]`: where the geometry comes from, its material, supports and loads.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Unique name in the scene.
+    pub name: String,
+    /// Nodes file (paper format), relative to the scene file.
+    pub nodes: Option<String>,
+    /// Links file (paper format), relative to the scene file.
+    pub links: Option<String>,
+    /// Patches file (paper format), relative to the scene file.
+    pub patches: Option<String>,
+    /// Default material of the members.
+    pub material: Option<String>,
+    /// `"linear"` (the paper's model, default).
+    pub kinematics: Option<String>,
+    /// `"direct"` or `"auto"` (default).
+    pub solver: Option<String>,
+    /// Generated circular disk (paper Fig. 1).
+    pub disk: Option<DiskSpec>,
+    /// Generated 2D rectangular solid (paper Fig. 4–6).
+    pub rectangle: Option<RectangleSpec>,
+    /// Generated 3D cylindrical shell (paper Fig. 7).
+    pub cylindrical_shell: Option<ShellSpec>,
+    /// Generated 3D box lattice.
+    pub box_lattice: Option<LatticeSpec>,
+    /// Supports.
+    #[serde(default)]
+    pub supports: Vec<Spanned<SupportSpec>>,
+    /// Nodal loads.
+    #[serde(default)]
+    pub loads: Vec<Spanned<LoadSpec>>,
+}
+
+/// `disk = { radius, rings, sectors }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiskSpec {
+    /// Radius, m.
+    pub radius: Real,
+    /// Rings of nodes around the centre (default 1).
+    #[serde(default = "one")]
+    pub rings: usize,
+    /// Nodes per ring (default 8).
+    #[serde(default = "eight")]
+    pub sectors: usize,
+}
+
+fn eight() -> usize {
+    8
+}
+
+/// `rectangle = { width, height, cells = [nx, ny] }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RectangleSpec {
+    /// Extent in x, m.
+    pub width: Real,
+    /// Extent in y, m.
+    pub height: Real,
+    /// Cells in x and y.
+    pub cells: [usize; 2],
+}
+
+/// `cylindrical_shell = { radius, length, rings, sectors }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShellSpec {
+    /// Radius, m.
+    pub radius: Real,
+    /// Length along x, m.
+    pub length: Real,
+    /// Rings of nodes along the axis (≥ 2).
+    pub rings: usize,
+    /// Nodes per ring (≥ 3).
+    pub sectors: usize,
+}
+
+/// `box_lattice = { size = [x, y, z], cells = [nx, ny, nz] }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatticeSpec {
+    /// Extent, m.
+    pub size: [Real; 3],
+    /// Cells per direction.
+    pub cells: [usize; 3],
+}
+
+/// Which nodes a support or load applies to: exactly one of the selector keys.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SelectorSpec {
+    /// 1-based node numbers.
+    pub nodes: Option<Vec<i64>>,
+    /// The one node nearest this point, m.
+    pub nearest: Option<Vec<Real>>,
+    /// Every node inside this axis-aligned box (bounds included, widened by `tolerance`).
+    pub inside: Option<BoxSpec>,
+    /// Every node within `tolerance` of this line.
+    pub on_line: Option<LineSpec>,
+    /// Every node within `tolerance` of this plane.
+    pub on_plane: Option<PlaneSpec>,
+    /// Distance within which a node counts as on a line, plane or box, m (default 1e-6 of the body size).
+    pub tolerance: Option<Real>,
+}
+
+/// `inside = { min = [..], max = [..] }`, m.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    /// Lower corner, m.
+    pub min: Vec<Real>,
+    /// Upper corner, m.
+    pub max: Vec<Real>,
+}
+
+/// `on_line = { point = [..], direction = [..] }`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineSpec {
+    /// A point of the line, m.
+    pub point: Vec<Real>,
+    /// Its direction (any length).
+    pub direction: Vec<Real>,
+}
+
+/// `on_plane = { point = [..], normal = [..] }`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneSpec {
+    /// A point of the plane, m.
+    pub point: Vec<Real>,
+    /// Its normal (any length).
+    pub normal: Vec<Real>,
+}
+
+/// `[[bodies.supports]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupportSpec {
+    /// 1-based node numbers.
+    pub nodes: Option<Vec<i64>>,
+    /// See [`SelectorSpec`].
+    pub nearest: Option<Vec<Real>>,
+    /// See [`SelectorSpec`].
+    pub inside: Option<BoxSpec>,
+    /// See [`SelectorSpec`].
+    pub on_line: Option<LineSpec>,
+    /// See [`SelectorSpec`].
+    pub on_plane: Option<PlaneSpec>,
+    /// See [`SelectorSpec`].
+    pub tolerance: Option<Real>,
+    /// Held directions: any of "x", "y", "z".
+    pub fix: Vec<String>,
+    /// Prescribed displacement at full schedule, m, one component per direction of the body;
+    /// only fixed directions may be non-zero.
+    pub displacement: Option<Vec<Real>>,
+    /// Factor per step 1..=steps (default: linear ramp).
+    pub schedule: Option<Vec<Real>>,
+}
+
+/// `[[bodies.loads]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// 1-based node numbers.
+    pub nodes: Option<Vec<i64>>,
+    /// See [`SelectorSpec`].
+    pub nearest: Option<Vec<Real>>,
+    /// See [`SelectorSpec`].
+    pub inside: Option<BoxSpec>,
+    /// See [`SelectorSpec`].
+    pub on_line: Option<LineSpec>,
+    /// See [`SelectorSpec`].
+    pub on_plane: Option<PlaneSpec>,
+    /// See [`SelectorSpec`].
+    pub tolerance: Option<Real>,
+    /// Force per selected node at full schedule, N.
+    pub force: Option<Vec<Real>>,
+    /// Total force shared equally by the selected nodes at full schedule, N.
+    pub total_force: Option<Vec<Real>>,
+    /// Factor per step 1..=steps (default: linear ramp).
+    pub schedule: Option<Vec<Real>>,
+}
+
+/// `[output]`: which steps are written.
+#[derive(Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Write every k-th step (step 0 and the last are always written); default 1.
+    pub every: Option<usize>,
+    /// Write only the last step (and step 0).
+    #[serde(default)]
+    pub last_only: bool,
+}
+
+macro_rules! selector_of {
+    ($t:ty) => {
+        impl $t {
+            /// The selector keys of this entry.
+            pub fn selector(&self) -> SelectorSpec {
+                SelectorSpec {
+                    nodes: self.nodes.clone(),
+                    nearest: self.nearest.clone(),
+                    inside: self.inside.clone(),
+                    on_line: self.on_line.clone(),
+                    on_plane: self.on_plane.clone(),
+                    tolerance: self.tolerance,
+                }
+            }
+        }
+    };
+}
+selector_of!(SupportSpec);
+selector_of!(LoadSpec);

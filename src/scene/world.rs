@@ -1,0 +1,62 @@
+use crate::linkage::{Body, Schedule};
+use crate::Real;
+use std::path::PathBuf;
+
+/// Which stored steps are written to `steps/NNNN.json`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OutputSettings {
+    /// Write every k-th step (≥ 1).
+    pub every: usize,
+    /// Write only step 0 and the last step.
+    pub last_only: bool,
+}
+
+impl Default for OutputSettings {
+    fn default() -> Self {
+        OutputSettings {
+            every: 1,
+            last_only: false,
+        }
+    }
+}
+
+impl OutputSettings {
+    /// Whether `step` of `steps` is written: step 0 and the last always are.
+    pub fn writes(&self, step: usize, steps: usize) -> bool {
+        step == 0 || step == steps || (!self.last_only && step.is_multiple_of(self.every))
+    }
+}
+
+/// Everything one run needs, built and checked from a scene file: plain data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct World {
+    /// Scene name: the output folder.
+    pub name: String,
+    /// Number of load steps.
+    pub steps: usize,
+    /// The deformable bodies.
+    pub bodies: Vec<Body>,
+    /// Which steps to write.
+    pub output: OutputSettings,
+    /// The scene file it came from.
+    pub source: PathBuf,
+}
+
+impl World {
+    /// The load factor reported for `step`: the common schedule's factor when every load and
+    /// prescribed displacement of the scene follows one schedule, else `step / steps`.
+    pub fn load_factor(&self, step: usize) -> Real {
+        let mut schedules = self.bodies.iter().flat_map(|b| {
+            b.loads.iter().map(|l| &l.schedule).chain(
+                b.supports
+                    .iter()
+                    .filter(|s| s.displacement.norm() > 0.0)
+                    .map(|s| &s.schedule),
+            )
+        });
+        match schedules.next() {
+            Some(first) if schedules.all(|s| s == first) => first.factor(step, self.steps),
+            _ => Schedule::Linear.factor(step, self.steps),
+        }
+    }
+}

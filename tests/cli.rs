@@ -1,0 +1,176 @@
+//! The `linkage` command end to end: batches, exit codes, output files and their contract.
+
+use std::path::Path;
+use std::process::Command;
+
+fn linkage() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_linkage"))
+}
+
+#[test]
+fn run_writes_the_output_contract() {
+    let out = tempfile::tempdir().unwrap();
+    let status = linkage()
+        .args([
+            "run",
+            "scenes/paper_square.toml",
+            "scenes/paper_overload.toml",
+            "--out",
+        ])
+        .arg(out.path())
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&status.stdout);
+    assert_eq!(
+        stdout.lines().filter(|l| l.starts_with("ok")).count(),
+        2,
+        "{stdout}"
+    );
+
+    let dir = out.path().join("paper_square");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["scene"], "paper_square");
+    let steps = summary["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 2);
+    for key in [
+        "step",
+        "load_factor",
+        "iterations",
+        "contact_iterations",
+        "residual",
+        "max_displacement",
+        "overloaded",
+        "max_penetration",
+        "seconds",
+    ] {
+        assert!(steps[1].get(key).is_some(), "summary lacks {key}");
+    }
+    let step: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("steps/0001.json")).unwrap()).unwrap();
+    assert_eq!(step["step"], 1);
+    assert_eq!(step["load_factor"], 1.0);
+    let body = &step["bodies"][0];
+    assert_eq!(body["name"], "square");
+    assert_eq!(body["displacements"].as_array().unwrap().len(), 4);
+    assert_eq!(body["displacements"][0].as_array().unwrap().len(), 2);
+    assert_eq!(body["axial_forces"].as_array().unwrap().len(), 6);
+    assert_eq!(body["reactions"][0]["node"], 3);
+    assert_eq!(body["loads"][0]["node"], 2);
+    assert_eq!(body["loads"][0]["force"][0], 200.0);
+    // positions = nodes + displacements (node 3 is pinned at the origin).
+    assert_eq!(body["positions"][2][0], 0.0);
+    assert!(body["contacts"].as_array().unwrap().is_empty());
+    let zero: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("steps/0000.json")).unwrap()).unwrap();
+    assert_eq!(zero["bodies"][0]["displacements"][0][0], 0.0);
+    // All 11 steps of the overload scene are there, and no temporary files anywhere.
+    assert_eq!(
+        std::fs::read_dir(out.path().join("paper_overload/steps"))
+            .unwrap()
+            .count(),
+        11
+    );
+    for entry in std::fs::read_dir(out.path()).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        assert!(!name.starts_with('.'), "left behind {name}");
+    }
+}
+
+#[test]
+fn a_failing_scene_fails_the_batch_but_not_the_others_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        "name = \"bad\"\n[[materials]]\nname = \"s\"\nyoungs_modulus = 1e9\narea = 1e-4\n[[bodies]]\nname = \"b\"\nrectangle = { width = 1.0, height = 1.0, cells = [2, 2] }\n[[bodies.supports]]\nnearest = [0.0, 0.0]\nfix = [\"x\", \"y\"]\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let result = linkage()
+        .args(["run", "scenes/paper_square.toml"])
+        .arg(&bad)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!result.status.success());
+    let stdout = String::from_utf8_lossy(&result.stdout);
+    assert!(
+        stdout.contains("FAIL") && stdout.contains("bad.toml") && stdout.contains("rigid-body"),
+        "{stdout}"
+    );
+    assert!(out.join("paper_square/summary.json").exists());
+    assert!(!out.join("bad").exists(), "a failed scene leaves no output");
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1);
+}
+
+#[test]
+fn output_every_and_last_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::fs::read_to_string("scenes/paper_overload.toml").unwrap();
+    let scene = dir.path().join("o.toml");
+    std::fs::write(&scene, format!("{src}\n[output]\nevery = 4\n")).unwrap();
+    let out = dir.path().join("out");
+    assert!(linkage()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .status()
+        .unwrap()
+        .success());
+    let mut names: Vec<String> = std::fs::read_dir(out.join("paper_overload/steps"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["0000.json", "0004.json", "0008.json", "0010.json"]);
+    std::fs::write(&scene, format!("{src}\n[output]\nlast_only = true\n")).unwrap();
+    assert!(linkage()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .status()
+        .unwrap()
+        .success());
+    assert_eq!(
+        std::fs::read_dir(out.join("paper_overload/steps"))
+            .unwrap()
+            .count(),
+        2
+    );
+    // The summary still has every step.
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("paper_overload/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["steps"].as_array().unwrap().len(), 11);
+}
+
+#[test]
+fn check_prints_sizes_without_solving() {
+    let result = linkage()
+        .args([
+            "check",
+            "scenes/paper_shell.toml",
+            "scenes/paper_square.toml",
+        ])
+        .output()
+        .unwrap();
+    assert!(result.status.success());
+    let stdout = String::from_utf8_lossy(&result.stdout);
+    assert!(stdout.contains("4 nodes, 6 members"), "{stdout}");
+    assert!(Path::new("scenes/paper_shell.toml").exists());
+    let missing = linkage()
+        .args(["check", "scenes/nope.toml"])
+        .output()
+        .unwrap();
+    assert!(!missing.status.success());
+    assert!(String::from_utf8_lossy(&missing.stdout).contains("nope.toml"));
+}
