@@ -40,6 +40,15 @@ enum Command {
         #[arg(required = true)]
         scenes: Vec<PathBuf>,
     },
+    /// Write each body of a scene (generated or read) as the paper's files:
+    /// DIR/<body>.nodes, DIR/<body>.links (with a material column) and DIR/<body>.patches.
+    Export {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Time assembly, ordering, factorization and solve on 3D box lattices.
     Bench {
         /// Lattice sizes in cells, e.g. 20x20x40 (default: a series up to over 1,000,000 members).
@@ -73,6 +82,7 @@ fn main() -> ExitCode {
     let outcome = match cli.command {
         Command::Run { scenes, out, jobs } => run_scenes(&scenes, &out, jobs),
         Command::Check { scenes } => check_scenes(&scenes),
+        Command::Export { scene, out } => export(&scene, &out),
         Command::Bench { cells, in_process } => bench(cells, in_process),
     };
     match outcome {
@@ -180,6 +190,41 @@ fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
             "{failed} of {} scene{} failed the check",
             scenes.len(),
             if scenes.len() == 1 { "" } else { "s" }
+        );
+    }
+    Ok(())
+}
+
+fn export(scene: &Path, out: &Path) -> Result<()> {
+    use linkage::linkage::paper_files::{write_links, write_nodes, write_patches};
+    let world = load_scene(scene)?;
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create the output folder {}", out.display()))?;
+    for body in &world.bodies {
+        let file = |ext: &str| out.join(format!("{}.{ext}", body.name));
+        let members: Vec<[usize; 2]> = body.members.iter().map(|m| m.nodes).collect();
+        let names: Vec<String> = body
+            .members
+            .iter()
+            .map(|m| body.materials[m.material].name.clone())
+            .collect();
+        let path = file("nodes");
+        write_nodes(&path, body.dimension, &body.nodes)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        let path = file("links");
+        write_links(&path, &members, Some(&names))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        if !body.patches.is_empty() {
+            let path = file("patches");
+            write_patches(&path, &body.patches)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        println!(
+            "wrote {}: {} nodes, {} members, {} patches",
+            file("*").display(),
+            body.nodes.len(),
+            body.members.len(),
+            body.patches.len()
         );
     }
     Ok(())
