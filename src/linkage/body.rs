@@ -1,4 +1,4 @@
-use crate::linkage::{Geometry, Material};
+use crate::linkage::{Geometry, Kinematics, Material, NewtonSettings, PathMethod};
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -109,6 +109,10 @@ pub struct Body {
     pub supports: Vec<Support>,
     /// Applied nodal forces.
     pub loads: Vec<NodalLoad>,
+    /// Small (the paper's) or large displacements.
+    pub kinematics: Kinematics,
+    /// How a nonlinear body (large kinematics, or tension- or compression-only members) is solved.
+    pub newton: NewtonSettings,
 }
 
 /// Why a body cannot be solved as given. Numbers in messages are 1-based.
@@ -227,6 +231,8 @@ impl Body {
             materials: vec![material],
             supports: Vec::new(),
             loads: Vec::new(),
+            kinematics: Kinematics::Linear,
+            newton: NewtonSettings::default(),
         }
     }
 
@@ -342,6 +348,63 @@ impl Body {
             self.check_target(&what, l.node)?;
             self.check_vector(&what, "force", &l.force)?;
             self.check_schedule(&what, &l.schedule)?;
+        }
+        self.check_newton()
+    }
+
+    /// Whether this body needs the Newton solve: large kinematics, a path method other than the
+    /// schedules, or members that act in tension or compression only.
+    pub fn is_nonlinear(&self) -> bool {
+        self.kinematics == Kinematics::Large
+            || self.newton.path != PathMethod::Schedules
+            || self
+                .members
+                .iter()
+                .any(|m| self.materials[m.material].behaviour != crate::linkage::Behaviour::Elastic)
+    }
+
+    fn check_newton(&self) -> Result<(), BodyError> {
+        let n = &self.newton;
+        let bad = |problem: String| BodyError::BadValue {
+            body: self.name.clone(),
+            what: "[bodies.newton]".to_string(),
+            problem,
+        };
+        let positive = |v: Real| v.is_finite() && v > 0.0;
+        if !positive(n.tolerance) || n.tolerance >= 1.0 {
+            return Err(bad(format!(
+                "tolerance = {} must be between 0 and 1 (e.g. 1e-8)",
+                n.tolerance
+            )));
+        }
+        if !positive(n.displacement_tolerance) || n.displacement_tolerance >= 1.0 {
+            return Err(bad(format!(
+                "displacement_tolerance = {} must be between 0 and 1 (e.g. 1e-6)",
+                n.displacement_tolerance
+            )));
+        }
+        if n.max_iterations == 0 {
+            return Err(bad("max_iterations must be at least 1".to_string()));
+        }
+        if let PathMethod::ArcLength { length } = n.path {
+            if !positive(length) {
+                return Err(BodyError::BadValue {
+                    body: self.name.clone(),
+                    what: "[bodies.path]".to_string(),
+                    problem: format!("arc_length = {length} must be a finite positive length in m"),
+                });
+            }
+            if self
+                .supports
+                .iter()
+                .any(|s| s.displacement != Vector3::zeros())
+            {
+                return Err(BodyError::BadValue {
+                    body: self.name.clone(),
+                    what: "[bodies.path]".to_string(),
+                    problem: "the arc-length method scales the loads only: prescribed support displacements are not allowed (use method = \"schedules\" for displacement control)".to_string(),
+                });
+            }
         }
         Ok(())
     }

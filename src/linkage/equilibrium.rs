@@ -1,34 +1,13 @@
 use crate::linkage::assembly::ModelTooLarge;
 use crate::linkage::cholesky::{CholeskyError, SparseCholesky};
 use crate::linkage::mechanism::{diagnose_mechanism, Mechanism};
+use crate::linkage::step_state::post_process;
 use crate::linkage::{
-    axial_stiffness, member_block, Body, BodyError, DofMap, DofSlot, Schedule, StiffnessAssembly,
+    axial_stiffness, member_block, Body, BodyError, DofMap, Schedule, StepState, StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
 use std::time::Instant;
-
-/// The solved state of a body at one load step.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct StepState {
-    /// Displacement of every node, m.
-    pub displacements: Vec<Vector3<Real>>,
-    /// Axial force of every member, N, tension positive.
-    pub axial_forces: Vec<Real>,
-    /// Engineering strain of every member (change of length over length), tension positive.
-    pub strains: Vec<Real>,
-    /// Axial stress of every member, Pa, tension positive.
-    pub stresses: Vec<Real>,
-    /// Members (0-based) whose stress is beyond their material's strength.
-    pub overloaded: Vec<usize>,
-    /// Per supported node (0-based), the force the supports exert on the body, N (paper Eq. 10).
-    pub reactions: Vec<(usize, Vector3<Real>)>,
-    /// Per loaded node (0-based), the applied force at this step, N.
-    pub loads: Vec<(usize, Vector3<Real>)>,
-    /// Out-of-balance force at the free DOFs over the largest of applied force and reaction
-    /// norms (0 when nothing is loaded).
-    pub residual: Real,
-}
 
 /// Wall time of the phases of a linear solve, s.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -62,6 +41,20 @@ pub enum SolveError {
         body: String,
         /// What faer reported.
         message: String,
+    },
+    /// A nonlinear step did not converge even after halving its increment `cuts` times.
+    #[error("body '{body}': step {step} did not converge after {cuts} halvings of its load increment: {reason}; relative residuals of the last attempt: [{}]. Use more steps (smaller increments), raise [bodies.newton] max_cuts or max_iterations, or follow a limit point with [bodies.path] method = \"arc_length\"", format_history(.history))]
+    NotConverged {
+        /// Body name.
+        body: String,
+        /// The step (1-based) that failed.
+        step: usize,
+        /// Halvings tried.
+        cuts: usize,
+        /// Why the last attempt failed.
+        reason: String,
+        /// Relative residual after each iteration of the last attempt.
+        history: Vec<Real>,
     },
     /// The solve returned a result that does not satisfy equilibrium.
     #[error("body '{body}': the solution misses equilibrium by {residual:e} (relative): the stiffness matrix is too ill-conditioned (members of very different stiffness, or nearly collinear members); check the materials and the geometry")]
@@ -276,78 +269,18 @@ impl Equilibrium {
                 forces[i] += f * p.forces[i];
             }
         }
-        let mut state = StepState {
-            displacements: (0..body.nodes.len())
-                .map(|i| {
-                    let mut v = Vector3::zeros();
-                    for k in 0..d {
-                        v[k] = u[i * d + k];
-                    }
-                    v
-                })
-                .collect(),
-            ..Default::default()
-        };
-        for (m, member) in body.members.iter().enumerate() {
-            let [a, b] = member.nodes;
-            let n = axis(body, a, b);
-            let length = body.member_length(m);
-            let strain = n.dot(&(state.displacements[b] - state.displacements[a])) / length;
-            let material = &body.materials[member.material];
-            let stress = material.youngs_modulus * strain;
-            state.strains.push(strain);
-            state.stresses.push(stress);
-            state.axial_forces.push(stress * material.area);
-            if material.is_overloaded(stress) {
-                state.overloaded.push(m);
-            }
-        }
         let mut internal = vec![0.0; nd];
         self.internal_forces(body, &u, &mut internal);
-        let mut supported_node = vec![false; body.nodes.len()];
-        for &dof in &self.dofs.supported {
-            supported_node[dof / d] = true;
-        }
-        for (node, _) in supported_node.iter().enumerate().filter(|(_, s)| **s) {
-            let mut r = Vector3::zeros();
-            for k in 0..d {
-                if let DofSlot::Supported(_) = self.dofs.slots[node * d + k] {
-                    r[k] = internal[node * d + k] - forces[node * d + k];
-                }
-            }
-            state.reactions.push((node, r));
-        }
-        let mut loaded = vec![false; body.nodes.len()];
-        for l in &body.loads {
-            loaded[l.node] = true;
-        }
-        for (node, _) in loaded.iter().enumerate().filter(|(_, l)| **l) {
-            let mut f = Vector3::zeros();
-            for k in 0..d {
-                f[k] = forces[node * d + k];
-            }
-            state.loads.push((node, f));
-        }
-        let out_of_balance: Real = self
-            .dofs
-            .free
-            .iter()
-            .map(|&dof| (internal[dof] - forces[dof]).powi(2))
-            .sum::<Real>()
-            .sqrt();
-        let applied = forces.iter().map(|f| f * f).sum::<Real>().sqrt();
-        let reacted = state
-            .reactions
-            .iter()
-            .map(|(_, r)| r.norm_squared())
-            .sum::<Real>()
-            .sqrt();
-        let scale = applied.max(reacted);
-        state.residual = if scale > 0.0 {
-            out_of_balance / scale
-        } else {
-            0.0
-        };
+        let members = body.members.iter().enumerate().map(|(m, member)| {
+            let [a, b] = member.nodes;
+            let n = axis(body, a, b);
+            let stretch: Real = (0..d).map(|k| n[k] * (u[b * d + k] - u[a * d + k])).sum();
+            let strain = stretch / body.member_length(m);
+            let material = &body.materials[member.material];
+            (strain, material.youngs_modulus * strain * material.area)
+        });
+        let mut state = post_process(body, &self.dofs, &u, &forces, &internal, members);
+        state.iterations = usize::from(step > 0);
         if !state.residual.is_finite() || state.residual > 1e-6 {
             return Err(SolveError::Inaccurate {
                 body: body.name.clone(),
@@ -356,6 +289,11 @@ impl Equilibrium {
         }
         Ok(state)
     }
+}
+
+fn format_history(history: &[Real]) -> String {
+    let items: Vec<String> = history.iter().map(|r| format!("{r:.1e}")).collect();
+    items.join(", ")
 }
 
 /// Unit vector from node `a` to node `b` in the undeformed body.

@@ -1,5 +1,28 @@
 use crate::Real;
 
+/// Which sign of axial force a member can carry.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Behaviour {
+    /// Carries tension and compression alike: `N = E A ε`.
+    #[default]
+    Elastic,
+    /// A cable: `N = E A ε` when stretched (ε > 0), zero when slack.
+    TensionOnly,
+    /// A strut that only pushes (a contact rod): `N = E A ε` when shortened (ε < 0), zero otherwise.
+    CompressionOnly,
+}
+
+impl Behaviour {
+    /// Whether a member at engineering strain `strain` carries force.
+    pub fn is_active(self, strain: Real) -> bool {
+        match self {
+            Behaviour::Elastic => true,
+            Behaviour::TensionOnly => strain > 0.0,
+            Behaviour::CompressionOnly => strain < 0.0,
+        }
+    }
+}
+
 /// The material and cross-section of a member: what the paper's `AE` is made of.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -13,6 +36,8 @@ pub struct Material {
     pub tensile_strength: Option<Real>,
     /// Largest compressive stress (given as a positive number), Pa (none: no limit).
     pub compressive_strength: Option<Real>,
+    /// Whether members of this material carry tension, compression or both.
+    pub behaviour: Behaviour,
 }
 
 impl Material {
@@ -24,6 +49,7 @@ impl Material {
             area,
             tensile_strength: None,
             compressive_strength: None,
+            behaviour: Behaviour::Elastic,
         }
     }
 

@@ -6,22 +6,33 @@ pub use self::body::{
     bounding_diagonal, check_members, Body, BodyError, Dimension, Member, MemberProblem, NodalLoad,
     Schedule, Support,
 };
+pub use self::body_solver::BodySolver;
 pub use self::dof_map::{direction_name, DofMap, DofSlot};
-pub use self::equilibrium::{Equilibrium, PhaseTimes, SolveError, StepState};
+pub use self::equilibrium::{Equilibrium, PhaseTimes, SolveError};
 pub use self::geometry::Geometry;
-pub use self::material::Material;
+pub use self::kinematics::{Kinematics, NewtonSettings, PathMethod};
+pub use self::material::{Behaviour, Material};
 pub use self::mechanism::Mechanism;
+pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
+pub use self::newton::NewtonEquilibrium;
+pub use self::step_state::StepState;
 
 mod assembly;
 mod body;
+mod body_solver;
 pub mod cholesky;
 mod dof_map;
 mod equilibrium;
 pub mod generators;
 mod geometry;
+mod kinematics;
 mod material;
 mod mechanism;
+mod member_response;
 mod member_stiffness;
+mod newton;
 pub mod ordering;
 pub mod paper_files;
+mod step_state;
+mod tangent_solver;

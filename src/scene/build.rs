@@ -2,7 +2,10 @@
 
 use crate::linkage::generators;
 use crate::linkage::paper_files::{self, PaperFileError};
-use crate::linkage::{Body, Dimension, Geometry, Material, Member, NodalLoad, Schedule, Support};
+use crate::linkage::{
+    Behaviour, Body, Dimension, Geometry, Kinematics, Material, Member, NewtonSettings, NodalLoad,
+    PathMethod, Schedule, Support,
+};
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
 use crate::scene::{OutputSettings, World};
@@ -144,11 +147,53 @@ fn material_from(m: &MaterialSpec) -> Result<Material, String> {
         area: m.area,
         tensile_strength: m.tensile_strength.or(m.strength),
         compressive_strength: m.compressive_strength.or(m.strength),
+        behaviour: match m.behaviour.as_deref() {
+            None | Some("elastic") => Behaviour::Elastic,
+            Some("tension_only") => Behaviour::TensionOnly,
+            Some("compression_only") => Behaviour::CompressionOnly,
+            Some(other) => {
+                return Err(format!(
+                    "material '{}': behaviour = {other:?}: use \"elastic\", \"tension_only\" (a cable) or \"compression_only\" (a strut)",
+                    m.name
+                ))
+            }
+        },
     };
     match material.problem() {
         Some(p) => Err(format!("material '{}': {p}", m.name)),
         None => Ok(material),
     }
+}
+
+/// `[bodies.newton]` and `[bodies.path]` over the defaults.
+fn newton_settings(spec: &BodySpec) -> Result<NewtonSettings, String> {
+    let mut settings = NewtonSettings::default();
+    if let Some(n) = &spec.newton {
+        settings.tolerance = n.tolerance.unwrap_or(settings.tolerance);
+        settings.displacement_tolerance = n
+            .displacement_tolerance
+            .unwrap_or(settings.displacement_tolerance);
+        settings.max_iterations = n.max_iterations.unwrap_or(settings.max_iterations);
+        settings.max_cuts = n.max_cuts.unwrap_or(settings.max_cuts);
+    }
+    if let Some(p) = &spec.path {
+        settings.path = match (p.method.as_str(), p.arc_length) {
+            ("schedules", None) => PathMethod::Schedules,
+            ("arc_length", Some(length)) => PathMethod::ArcLength { length },
+            ("arc_length", None) => {
+                return Err("[bodies.path] method = \"arc_length\" needs `arc_length` (m): the length of one step along the path".to_string())
+            }
+            ("schedules", Some(_)) => {
+                return Err("[bodies.path] `arc_length` goes with method = \"arc_length\"".to_string())
+            }
+            (other, _) => {
+                return Err(format!(
+                    "[bodies.path] method = {other:?}: use \"schedules\" (load and displacement control) or \"arc_length\""
+                ))
+            }
+        };
+    }
+    Ok(settings)
 }
 
 fn build_body(
@@ -160,14 +205,16 @@ fn build_body(
 ) -> Result<Body, SceneError> {
     let spec = spanned.get_ref();
     let here = |message: String| at(spanned.span(), format!("body '{}': {message}", spec.name));
-    match spec.kinematics.as_deref() {
-        None | Some("linear") => {}
+    let kinematics = match spec.kinematics.as_deref() {
+        None | Some("linear") => Kinematics::Linear,
+        Some("large") => Kinematics::Large,
         Some(other) => {
             return Err(here(format!(
-                "kinematics = {other:?} is not available: use \"linear\" (the paper's model)"
+                "kinematics = {other:?} is not available: use \"linear\" (the paper's model) or \"large\" (large displacements)"
             )))
         }
-    }
+    };
+    let newton = newton_settings(spec).map_err(here)?;
     match spec.solver.as_deref() {
         None | Some("direct") | Some("auto") => {}
         Some(other) => {
@@ -211,6 +258,8 @@ fn build_body(
     }
     let mut body = Body::new(&spec.name, Dimension::Two);
     body.materials = materials.to_vec();
+    body.kinematics = kinematics;
+    body.newton = newton;
     if from_files {
         let (Some(nodes_file), Some(links_file)) = (&spec.nodes, &spec.links) else {
             return Err(here(

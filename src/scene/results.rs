@@ -70,8 +70,11 @@ pub struct StepSummary {
     pub step: usize,
     /// Load factor.
     pub load_factor: Real,
-    /// Equilibrium iterations (a linear step is one).
+    /// Equilibrium iterations (a linear step is one; Newton iterations otherwise, largest over
+    /// the bodies).
     pub iterations: usize,
+    /// Halvings of the load increment Newton needed (all bodies; 0 for a linear step).
+    pub cuts: usize,
     /// Contact iterations (0 without contact).
     pub contact_iterations: usize,
     /// Relative out-of-balance force, largest over the bodies.
@@ -129,6 +132,10 @@ pub struct Summary {
     pub bodies: Vec<BodySize>,
     /// Where the time went.
     pub phases: PhaseSeconds,
+    /// Why the run stopped early (the steps listed were solved and written); absent when
+    /// every step was solved.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failure: Option<String>,
 }
 
 /// Components of a vector for a body of dimension `d` (2 or 3).

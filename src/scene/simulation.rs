@@ -1,7 +1,7 @@
 //! The load-step driver: solve every body at every step and write the results.
 
 use crate::atomic_file::write_atomically;
-use crate::linkage::{Equilibrium, SolveError};
+use crate::linkage::{BodySolver, SolveError};
 use crate::scene::results::{BodyResult, BodySize, PhaseSeconds, StepResult, StepSummary, Summary};
 use crate::scene::World;
 use crate::Real;
@@ -12,8 +12,8 @@ use std::time::Instant;
 pub struct Simulation<'w> {
     /// The scene being run.
     pub world: &'w World,
-    /// One linear equilibrium per body, in scene order.
-    pub equilibria: Vec<Equilibrium>,
+    /// One solver per body, in scene order: linear superposition, or Newton for a nonlinear body.
+    pub equilibria: Vec<BodySolver>,
 }
 
 /// Why a run stopped.
@@ -43,7 +43,7 @@ impl<'w> Simulation<'w> {
         let equilibria = world
             .bodies
             .iter()
-            .map(Equilibrium::new)
+            .map(BodySolver::new)
             .collect::<Result<Vec<_>, _>>()
             .map_err(|source| RunError::Solve {
                 scene: world.source.clone(),
@@ -63,7 +63,8 @@ impl<'w> Simulation<'w> {
         let mut summary = StepSummary {
             step,
             load_factor: result.load_factor,
-            iterations: usize::from(step > 0),
+            iterations: 0,
+            cuts: 0,
             contact_iterations: 0,
             residual: 0.0,
             max_displacement: 0.0,
@@ -79,6 +80,13 @@ impl<'w> Simulation<'w> {
                         source,
                     })?;
             summary.residual = summary.residual.max(state.residual);
+            summary.iterations = summary.iterations.max(state.iterations);
+            summary.cuts += state.cuts;
+            if let Some(lambda) = state.load_factor {
+                // The path (arc length) decided this body's load factor.
+                result.load_factor = lambda;
+                summary.load_factor = lambda;
+            }
             summary.overloaded += state.overloaded.len();
             summary.max_displacement = state
                 .displacements
@@ -102,7 +110,7 @@ impl<'w> Simulation<'w> {
                 nodes: b.nodes.len(),
                 members: b.members.len(),
                 patches: b.patches.len(),
-                free_dofs: eq.assembly.n,
+                free_dofs: eq.free_dofs(),
             })
             .collect()
     }
@@ -128,22 +136,30 @@ pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Sum
         }
         let steps_dir = staging.join("steps");
         std::fs::create_dir_all(&steps_dir).map_err(write_err(&steps_dir))?;
-        let mut phases = PhaseSeconds::default();
-        for eq in &simulation.equilibria {
-            phases.assembly += eq.times.assembly;
-            phases.symbolic += eq.times.symbolic;
-            phases.numeric += eq.times.numeric;
-            phases.solve += eq.times.solve;
-        }
         let mut summary = Summary {
             scene: world.name.clone(),
             steps: Vec::with_capacity(world.steps + 1),
             bodies: simulation.sizes(),
-            phases,
+            phases: PhaseSeconds::default(),
+            failure: None,
         };
+        let mut stopped = None;
         for step in 0..=world.steps {
             let t = Instant::now();
-            let (result, mut line) = simulation.step(step)?;
+            let (result, mut line) = match simulation.step(step) {
+                Ok(solved) => solved,
+                // A nonlinear step that cannot be solved ends the run, but the steps before it
+                // are kept and the summary says why it stopped.
+                Err(RunError::Solve {
+                    scene,
+                    source: source @ SolveError::NotConverged { .. },
+                }) => {
+                    summary.failure = Some(source.to_string());
+                    stopped = Some(RunError::Solve { scene, source });
+                    break;
+                }
+                Err(e) => return Err(e),
+            };
             line.seconds = t.elapsed().as_secs_f64() + if step == 1 { setup } else { 0.0 };
             if world.output.writes(step, world.steps) {
                 let t = Instant::now();
@@ -158,6 +174,13 @@ pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Sum
             summary.steps.push(line);
             on_step();
         }
+        for eq in &simulation.equilibria {
+            let times = eq.times();
+            summary.phases.assembly += times.assembly;
+            summary.phases.symbolic += times.symbolic;
+            summary.phases.numeric += times.numeric;
+            summary.phases.solve += times.solve;
+        }
         let path = staging.join("summary.json");
         let bytes = serde_json::to_vec_pretty(&summary).map_err(|e| RunError::Write {
             path: path.clone(),
@@ -165,9 +188,12 @@ pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Sum
         })?;
         write_atomically(&path, &bytes).map_err(write_err(&path))?;
         replace_dir(&staging, &final_dir).map_err(write_err(&final_dir))?;
-        Ok(summary)
+        match stopped {
+            Some(e) => Err(e),
+            None => Ok(summary),
+        }
     })();
-    if result.is_err() && staging.exists() {
+    if staging.exists() {
         let _ = std::fs::remove_dir_all(&staging);
     }
     result

@@ -44,6 +44,8 @@ pub struct MaterialSpec {
     pub tensile_strength: Option<Real>,
     /// Strength in compression as a positive number, Pa (overrides `strength`).
     pub compressive_strength: Option<Real>,
+    /// `"elastic"` (default), `"tension_only"` (a cable) or `"compression_only"` (a strut).
+    pub behaviour: Option<String>,
 }
 
 /// `[[bodies]]`: where the geometry comes from, its material, supports and loads.
@@ -60,8 +62,12 @@ pub struct BodySpec {
     pub patches: Option<String>,
     /// Default material of the members.
     pub material: Option<String>,
-    /// `"linear"` (the paper's model, default).
+    /// `"linear"` (the paper's model, default) or `"large"` (geometrically exact members).
     pub kinematics: Option<String>,
+    /// Newton settings of a nonlinear body.
+    pub newton: Option<NewtonSpec>,
+    /// How the load path is followed (schedules or arc length).
+    pub path: Option<PathSpec>,
     /// `"direct"` or `"auto"` (default).
     pub solver: Option<String>,
     /// Generated circular disk (paper Fig. 1).
@@ -78,6 +84,30 @@ pub struct BodySpec {
     /// Nodal loads.
     #[serde(default)]
     pub loads: Vec<Spanned<LoadSpec>>,
+}
+
+/// `[bodies.newton]`: convergence settings of the Newton solve (see `docs/SCENES.md`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NewtonSpec {
+    /// Relative out-of-balance force at convergence (default 1e-8).
+    pub tolerance: Option<Real>,
+    /// Relative size of the last displacement correction at convergence (default 1e-6).
+    pub displacement_tolerance: Option<Real>,
+    /// Newton iterations per increment before it is halved (default 30).
+    pub max_iterations: Option<usize>,
+    /// Halvings of the increment allowed per step (default 10).
+    pub max_cuts: Option<usize>,
+}
+
+/// `[bodies.path]`: `method = "schedules"` (default) or `"arc_length"` with `arc_length` (m).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathSpec {
+    /// `"schedules"` or `"arc_length"`.
+    pub method: String,
+    /// Arc length per step, m (arc-length method).
+    pub arc_length: Option<Real>,
 }
 
 /// `disk = { radius, rings, sectors }`.

@@ -1,0 +1,68 @@
+//! The solver a body needs: the paper's linear superposition, or Newton for a nonlinear body.
+
+use crate::linkage::{Body, Equilibrium, NewtonEquilibrium, PhaseTimes, SolveError, StepState};
+use std::sync::Mutex;
+
+/// One body's equilibrium solver, chosen by [`Body::is_nonlinear`].
+pub enum BodySolver {
+    /// Linear kinematics and elastic members: factor once, superpose load patterns.
+    Linear(Equilibrium),
+    /// Large kinematics, cables or struts, or an arc-length path: Newton step by step. The
+    /// lock holds the current state so steps can be asked for through a shared reference.
+    Nonlinear(Mutex<NewtonEquilibrium>),
+}
+
+impl BodySolver {
+    /// Validate `body` and prepare its solver (for a linear body: solve it).
+    pub fn new(body: &Body) -> Result<Self, SolveError> {
+        Ok(if body.is_nonlinear() {
+            BodySolver::Nonlinear(Mutex::new(NewtonEquilibrium::new(body)?))
+        } else {
+            BodySolver::Linear(Equilibrium::new(body)?)
+        })
+    }
+
+    /// The state at `step` of `steps`. A nonlinear body solves the steps in order (asking
+    /// for an earlier step than the last one solved restarts it).
+    pub fn solve_step(
+        &self,
+        body: &Body,
+        step: usize,
+        steps: usize,
+    ) -> Result<StepState, SolveError> {
+        match self {
+            BodySolver::Linear(eq) => eq.solve_step(body, step, steps),
+            BodySolver::Nonlinear(newton) => newton
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner())
+                .solve_step(body, step, steps),
+        }
+    }
+
+    /// Rows of `K_ff`.
+    pub fn free_dofs(&self) -> usize {
+        match self {
+            BodySolver::Linear(eq) => eq.assembly.n,
+            BodySolver::Nonlinear(newton) => {
+                newton
+                    .lock()
+                    .unwrap_or_else(|poisoned| poisoned.into_inner())
+                    .assembly
+                    .n
+            }
+        }
+    }
+
+    /// Time spent so far in each phase, s.
+    pub fn times(&self) -> PhaseTimes {
+        match self {
+            BodySolver::Linear(eq) => eq.times,
+            BodySolver::Nonlinear(newton) => {
+                newton
+                    .lock()
+                    .unwrap_or_else(|poisoned| poisoned.into_inner())
+                    .times
+            }
+        }
+    }
+}

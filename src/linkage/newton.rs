@@ -1,0 +1,711 @@
+//! Newton–Raphson equilibrium of a nonlinear body (large kinematics, cables, struts), load
+//! step by load step, with a line search and automatic halving of increments that do not
+//! converge; or along an arc length (see [`crate::linkage::PathMethod`]).
+//!
+//! At every iteration the tangent stiffness is refilled in the pattern computed once
+//! ([`StiffnessAssembly::fill`]) and refactored on the symbolic factorization computed once.
+
+use crate::linkage::mechanism::diagnose_mechanism;
+use crate::linkage::step_state::{force_scale, post_process};
+use crate::linkage::tangent_solver::{TangentError, TangentSolver};
+use crate::linkage::{
+    direction_name, member_response, Body, DofMap, MemberResponse, PathMethod, PhaseTimes,
+    Schedule, SolveError, StepState, StiffnessAssembly,
+};
+use crate::Real;
+use nalgebra::Vector3;
+use std::time::Instant;
+
+/// Why one load increment failed (the step is retried with half the increment).
+#[derive(Clone, Debug)]
+struct IncrementFailure {
+    reason: String,
+    history: Vec<Real>,
+}
+
+/// The nonlinear equilibrium of one body, advanced step by step. Holds the current
+/// displacement field between steps.
+pub struct NewtonEquilibrium {
+    /// The free/support partition.
+    pub dofs: DofMap,
+    /// The pattern of `K_ff` and the place of each member entry.
+    pub assembly: StiffnessAssembly,
+    /// Time spent in each phase so far, s (assembly: tangent refills and internal forces).
+    pub times: PhaseTimes,
+    /// Entries of the factor of the tangent.
+    pub factor_entries: usize,
+    /// Relative residual after each Newton iteration of the last increment solved (the
+    /// quadratic convergence shows here).
+    pub residual_history: Vec<Real>,
+    solver: Option<TangentSolver>,
+    values: Vec<Real>,
+    /// Displacement per body DOF at the last solved step, m.
+    u: Vec<Real>,
+    /// Load factor at the last solved step (arc length).
+    lambda: Real,
+    /// The step `u` belongs to.
+    step: usize,
+    /// The last converged increment of the free DOFs (arc length: keeps the path direction).
+    previous: Vec<Real>,
+    /// Negative pivots of the last factored tangent.
+    negative_pivots: usize,
+}
+
+impl NewtonEquilibrium {
+    /// Validate `body`, build its pattern, analyze it once and check that the undeformed
+    /// tangent is not singular (a mechanism is reported with its nodes).
+    pub fn new(body: &Body) -> Result<Self, SolveError> {
+        body.validate()?;
+        let t = Instant::now();
+        let dofs = DofMap::new(body);
+        let assembly = StiffnessAssembly::new(body, &dofs)?;
+        let nd = body.dof_count();
+        let mut eq = NewtonEquilibrium {
+            previous: vec![0.0; assembly.n],
+            dofs,
+            assembly,
+            times: PhaseTimes::default(),
+            factor_entries: 0,
+            residual_history: Vec::new(),
+            solver: None,
+            values: Vec::new(),
+            u: vec![0.0; nd],
+            lambda: 0.0,
+            step: 0,
+            negative_pivots: 0,
+        };
+        eq.fill_tangent(body);
+        eq.times.assembly += t.elapsed().as_secs_f64();
+        if eq.assembly.n > 0 {
+            let t = Instant::now();
+            let solver =
+                TangentSolver::new(&eq.assembly).map_err(|e| SolveError::Factorization {
+                    body: body.name.clone(),
+                    message: e.to_string(),
+                })?;
+            eq.times.symbolic += t.elapsed().as_secs_f64();
+            eq.solver = Some(solver);
+            let t = Instant::now();
+            let first = eq.factorize();
+            eq.times.numeric += t.elapsed().as_secs_f64();
+            match first {
+                Ok(_) => {}
+                Err(TangentError::Indefinite { dof }) => {
+                    let solver = eq.solver.as_mut().map(|s| s.cholesky_mut());
+                    if let Some(c) = solver {
+                        return Err(SolveError::Mechanism(Box::new(diagnose_mechanism(
+                            body,
+                            &eq.dofs,
+                            &eq.assembly,
+                            &eq.values,
+                            c,
+                            dof,
+                        ))));
+                    }
+                }
+                Err(TangentError::Other(message)) => {
+                    return Err(SolveError::Factorization {
+                        body: body.name.clone(),
+                        message,
+                    })
+                }
+            }
+            eq.factor_entries = eq.solver.as_ref().map_or(0, |s| s.factor_entries());
+        }
+        Ok(eq)
+    }
+
+    /// The state at `step` of `steps`. Steps are solved in order from the last one solved;
+    /// asking for an earlier step restarts from the undeformed state.
+    pub fn solve_step(
+        &mut self,
+        body: &Body,
+        step: usize,
+        steps: usize,
+    ) -> Result<StepState, SolveError> {
+        if step < self.step || step == 0 {
+            self.u.iter_mut().for_each(|v| *v = 0.0);
+            self.previous.iter_mut().for_each(|v| *v = 0.0);
+            self.lambda = 0.0;
+            self.step = 0;
+        }
+        let mut iterations = 0;
+        let mut cuts = 0;
+        while self.step < step {
+            let target = self.step + 1;
+            let (i, c) = match body.newton.path {
+                PathMethod::Schedules => self.advance_schedules(body, target, steps)?,
+                PathMethod::ArcLength { length } => {
+                    self.advance_arc_length(body, target, length)?
+                }
+            };
+            iterations += i;
+            cuts += c;
+            self.step = target;
+        }
+        let mut state = self.state(body, steps);
+        state.iterations = iterations;
+        state.cuts = cuts;
+        if !state.residual.is_finite()
+            || state
+                .displacements
+                .iter()
+                .any(|u| !u.iter().all(|c| c.is_finite()))
+        {
+            return Err(SolveError::Inaccurate {
+                body: body.name.clone(),
+                residual: state.residual,
+            });
+        }
+        Ok(state)
+    }
+
+    /// The full state at the current displacement (post-processing shared with the linear
+    /// solve).
+    fn state(&self, body: &Body, steps: usize) -> StepState {
+        let forces = self.forces_at(body, self.step as Real, steps);
+        let mut internal = vec![0.0; self.u.len()];
+        internal_forces(body, self.dofs.dofs_per_node, &self.u, &mut internal);
+        let d = self.dofs.dofs_per_node;
+        let members = (0..body.members.len()).map(|m| {
+            let r = response(body, d, &self.u, m);
+            (r.strain, r.force)
+        });
+        let mut state = post_process(body, &self.dofs, &self.u, &forces, &internal, members);
+        if let PathMethod::ArcLength { .. } = body.newton.path {
+            state.load_factor = Some(self.lambda);
+            let scale =
+                force_scale(&self.dofs, &forces, &internal).max(norm(&self.reference(body)));
+            state.residual =
+                free_norm(&self.dofs, &forces, &internal) / scale.max(Real::MIN_POSITIVE);
+        }
+        state.negative_pivots = self.negative_pivots;
+        state
+    }
+
+    /// Applied force per body DOF at pseudo-time `t` (step units, fractional between steps),
+    /// N: each load's schedule interpolated linearly between steps; in arc-length mode the
+    /// reference load times the current load factor.
+    fn forces_at(&self, body: &Body, t: Real, steps: usize) -> Vec<Real> {
+        if let PathMethod::ArcLength { .. } = body.newton.path {
+            return self
+                .reference(body)
+                .iter()
+                .map(|f| f * self.lambda)
+                .collect();
+        }
+        let d = self.dofs.dofs_per_node;
+        let mut f = vec![0.0; body.dof_count()];
+        for l in &body.loads {
+            let factor = factor_at(&l.schedule, t, steps);
+            for k in 0..d {
+                f[l.node * d + k] += factor * l.force[k];
+            }
+        }
+        f
+    }
+
+    /// The loads at full value per body DOF, N: the arc-length reference pattern.
+    fn reference(&self, body: &Body) -> Vec<Real> {
+        let d = self.dofs.dofs_per_node;
+        let mut f = vec![0.0; body.dof_count()];
+        for l in &body.loads {
+            for k in 0..d {
+                f[l.node * d + k] += l.force[k];
+            }
+        }
+        f
+    }
+
+    /// Prescribed displacement per body DOF at pseudo-time `t`, m (zero at free DOFs).
+    fn prescribed_at(&self, body: &Body, t: Real, steps: usize) -> Vec<Real> {
+        let d = self.dofs.dofs_per_node;
+        let mut u = vec![0.0; body.dof_count()];
+        for s in &body.supports {
+            if s.displacement == Vector3::zeros() {
+                continue;
+            }
+            let factor = factor_at(&s.schedule, t, steps);
+            for k in 0..d {
+                if s.fixed[k] {
+                    u[s.node * d + k] += factor * s.displacement[k];
+                }
+            }
+        }
+        u
+    }
+
+    fn fill_tangent(&mut self, body: &Body) {
+        let d = self.dofs.dofs_per_node;
+        let u = &self.u;
+        self.assembly
+            .fill(body, |m| response(body, d, u, m).tangent, &mut self.values);
+    }
+
+    fn factorize(&mut self) -> Result<usize, TangentError> {
+        let Some(solver) = self.solver.as_mut() else {
+            return Ok(0);
+        };
+        let negative = solver.factorize(&self.values)?;
+        self.negative_pivots = negative;
+        Ok(negative)
+    }
+
+    /// Refill and refactor the tangent at the current displacement.
+    fn refactor(&mut self, body: &Body) -> Result<(), String> {
+        let t = Instant::now();
+        self.fill_tangent(body);
+        self.times.assembly += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let result = self.factorize();
+        self.times.numeric += t.elapsed().as_secs_f64();
+        match result {
+            Ok(_) => Ok(()),
+            Err(TangentError::Indefinite { dof }) => {
+                let (node, dir) = self.dofs.node_and_direction(self.dofs.free[dof]);
+                Err(format!(
+                    "the tangent stiffness is singular or indefinite at node {} ({}): the body is at or past a limit point or buckles",
+                    node + 1,
+                    direction_name(dir)
+                ))
+            }
+            Err(TangentError::Other(m)) => Err(m),
+        }
+    }
+
+    fn solve(&mut self, rhs: &mut [Real]) {
+        let t = Instant::now();
+        if let Some(s) = self.solver.as_mut() {
+            s.solve_in_place(rhs);
+        }
+        self.times.solve += t.elapsed().as_secs_f64();
+    }
+
+    /// Internal forces and the free out-of-balance `F − f_int` at `u`, timed as assembly.
+    fn out_of_balance(
+        &mut self,
+        body: &Body,
+        u: &[Real],
+        forces: &[Real],
+        internal: &mut [Real],
+    ) -> Vec<Real> {
+        let t = Instant::now();
+        internal_forces(body, self.dofs.dofs_per_node, u, internal);
+        self.times.assembly += t.elapsed().as_secs_f64();
+        self.dofs
+            .free
+            .iter()
+            .map(|&dof| forces[dof] - internal[dof])
+            .collect()
+    }
+
+    /// Load control: advance from `target − 1` to `target`, halving the increment when it
+    /// does not converge. Returns (Newton iterations, cuts).
+    fn advance_schedules(
+        &mut self,
+        body: &Body,
+        target: usize,
+        steps: usize,
+    ) -> Result<(usize, usize), SolveError> {
+        let end = target as Real;
+        let mut t = (target - 1) as Real;
+        let mut dt = 1.0;
+        let (mut iterations, mut cuts) = (0, 0);
+        while t < end {
+            let t1 = if end - t <= dt * (1.0 + 1e-12) {
+                end
+            } else {
+                t + dt
+            };
+            let saved = self.u.clone();
+            match self.increment(body, t1, steps) {
+                Ok(n) => {
+                    iterations += n;
+                    t = t1;
+                    dt = (dt * 2.0).min(1.0);
+                }
+                Err(failure) => {
+                    iterations += failure.history.len();
+                    self.u = saved;
+                    cuts += 1;
+                    if cuts > body.newton.max_cuts {
+                        return Err(not_converged(body, target, cuts - 1, failure));
+                    }
+                    dt *= 0.5;
+                }
+            }
+        }
+        Ok((iterations, cuts))
+    }
+
+    /// One load-control increment from the current state to pseudo-time `t1`: a tangent
+    /// predictor (which also moves the prescribed supports), then Newton corrections with a
+    /// line search. Returns the Newton iterations.
+    fn increment(
+        &mut self,
+        body: &Body,
+        t1: Real,
+        steps: usize,
+    ) -> Result<usize, IncrementFailure> {
+        let settings = body.newton;
+        let nd = body.dof_count();
+        let forces = self.forces_at(body, t1, steps);
+        let prescribed = self.prescribed_at(body, t1, steps);
+        let mut history = Vec::new();
+        let fail = |reason: String, history: &Vec<Real>| IncrementFailure {
+            reason,
+            history: history.clone(),
+        };
+        // Predictor: K_ff Δu_f = F_f − f_int,f − K_fs Δu_s.
+        let mut internal = vec![0.0; nd];
+        let mut rhs = self.out_of_balance(body, &self.u.clone(), &forces, &mut internal);
+        self.refactor(body).map_err(|r| fail(r, &history))?;
+        let mut du_s = vec![0.0; nd];
+        let mut moved = false;
+        for &dof in &self.dofs.supported {
+            du_s[dof] = prescribed[dof] - self.u[dof];
+            moved |= du_s[dof] != 0.0;
+        }
+        if moved {
+            let mut k_du = vec![0.0; nd];
+            tangent_times(body, self.dofs.dofs_per_node, &self.u, &du_s, &mut k_du);
+            for (i, &dof) in self.dofs.free.iter().enumerate() {
+                rhs[i] -= k_du[dof];
+            }
+        }
+        self.solve(&mut rhs);
+        for &dof in &self.dofs.supported {
+            self.u[dof] = prescribed[dof];
+        }
+        for (i, &dof) in self.dofs.free.iter().enumerate() {
+            self.u[dof] += rhs[i];
+        }
+        let mut last_step = norm(&rhs);
+        let mut iterations = 1;
+        loop {
+            let r = self.out_of_balance(body, &self.u.clone(), &forces, &mut internal);
+            let scale = force_scale(&self.dofs, &forces, &internal);
+            let rnorm = norm(&r);
+            let relative = if scale > 0.0 {
+                rnorm / scale
+            } else if rnorm > 0.0 {
+                Real::INFINITY
+            } else {
+                0.0
+            };
+            history.push(relative);
+            if !relative.is_finite() {
+                return Err(fail(
+                    "the residual is not finite (a member collapsed or the iteration diverged)"
+                        .to_string(),
+                    &history,
+                ));
+            }
+            if relative <= settings.tolerance
+                && last_step
+                    <= settings.displacement_tolerance * norm(&self.u).max(Real::MIN_POSITIVE)
+            {
+                self.residual_history = history;
+                return Ok(iterations);
+            }
+            if relative <= settings.tolerance && rnorm == 0.0 {
+                self.residual_history = history;
+                return Ok(iterations);
+            }
+            if iterations >= settings.max_iterations {
+                return Err(fail(
+                    format!(
+                        "no convergence in {} Newton iterations",
+                        settings.max_iterations
+                    ),
+                    &history,
+                ));
+            }
+            self.refactor(body)
+                .map_err(|reason| fail(reason, &history))?;
+            let mut delta = r.clone();
+            self.solve(&mut delta);
+            last_step = self.line_search(body, &forces, &delta, rnorm, &mut internal);
+            iterations += 1;
+        }
+    }
+
+    /// Move the free DOFs by `s δ` with `s` = 1, 1/2, … 1/16: the first `s` that lowers the
+    /// out-of-balance norm (Armijo, 1e-4), else the best tried. Returns the length moved.
+    fn line_search(
+        &mut self,
+        body: &Body,
+        forces: &[Real],
+        delta: &[Real],
+        r0: Real,
+        internal: &mut [Real],
+    ) -> Real {
+        let base = self.u.clone();
+        let mut trial = base.clone();
+        let mut best = (Real::INFINITY, 1.0);
+        let mut s = 1.0;
+        for _ in 0..5 {
+            for (i, &dof) in self.dofs.free.iter().enumerate() {
+                trial[dof] = base[dof] + s * delta[i];
+            }
+            let r = norm(&self.out_of_balance(body, &trial, forces, internal));
+            if r.is_finite() && r <= (1.0 - 1e-4 * s) * r0 {
+                self.u = trial;
+                return s * norm(delta);
+            }
+            if r < best.0 {
+                best = (r, s);
+            }
+            s *= 0.5;
+        }
+        // No step lowered the residual: take the best (or the full step if all diverged); the
+        // iteration limit decides.
+        let s = if best.0.is_finite() { best.1 } else { 1.0 };
+        for (i, &dof) in self.dofs.free.iter().enumerate() {
+            self.u[dof] = base[dof] + s * delta[i];
+        }
+        s * norm(delta)
+    }
+
+    /// Arc length: advance one step of `length` along the path, in sub-increments that are
+    /// halved when they do not converge. Returns (Newton iterations, cuts).
+    fn advance_arc_length(
+        &mut self,
+        body: &Body,
+        target: usize,
+        length: Real,
+    ) -> Result<(usize, usize), SolveError> {
+        let mut covered = 0.0;
+        let mut dl = length;
+        let (mut iterations, mut cuts) = (0, 0);
+        while covered < length * (1.0 - 1e-12) {
+            let arc = dl.min(length - covered);
+            let (u0, l0, p0) = (self.u.clone(), self.lambda, self.previous.clone());
+            match self.arc_increment(body, arc) {
+                Ok(n) => {
+                    iterations += n;
+                    covered += arc;
+                    dl = (dl * 2.0).min(length);
+                }
+                Err(failure) => {
+                    iterations += failure.history.len();
+                    (self.u, self.lambda, self.previous) = (u0, l0, p0);
+                    cuts += 1;
+                    if cuts > body.newton.max_cuts {
+                        return Err(not_converged(body, target, cuts - 1, failure));
+                    }
+                    dl *= 0.5;
+                }
+            }
+        }
+        Ok((iterations, cuts))
+    }
+
+    /// One increment of Crisfield's cylindrical arc-length method: `|Δu_f| = arc`, with the
+    /// load factor λ an unknown. Predictor along the tangent `K δu_t = F_ref`, in the direction
+    /// of the previous increment; corrections `δu = δu_R + δλ δu_t` with δλ from the
+    /// constraint's quadratic, the root keeping the increment closest to the previous one.
+    fn arc_increment(&mut self, body: &Body, arc: Real) -> Result<usize, IncrementFailure> {
+        let settings = body.newton;
+        let nd = body.dof_count();
+        let reference = self.reference(body);
+        let ref_f: Vec<Real> = self.dofs.free.iter().map(|&dof| reference[dof]).collect();
+        let ref_norm = norm(&reference);
+        let mut history = Vec::new();
+        let fail = |reason: String, history: &Vec<Real>| IncrementFailure {
+            reason,
+            history: history.clone(),
+        };
+        if ref_norm == 0.0 {
+            return Err(fail(
+                "the arc-length method needs loads to scale: add [[bodies.loads]]".to_string(),
+                &history,
+            ));
+        }
+        let u0 = self.u.clone();
+        let lambda0 = self.lambda;
+        self.refactor(body).map_err(|r| fail(r, &history))?;
+        let mut dt = ref_f.clone();
+        self.solve(&mut dt);
+        let dt_norm = norm(&dt);
+        if !(dt_norm.is_finite() && dt_norm > 0.0) {
+            return Err(fail(
+                "the tangent solve along the reference load failed".to_string(),
+                &history,
+            ));
+        }
+        // Follow the previous direction (Feng's criterion); the first step loads positively.
+        let dot: Real = self.previous.iter().zip(&dt).map(|(a, b)| a * b).sum();
+        let sign = if dot < 0.0 { -1.0 } else { 1.0 };
+        let mut dlambda = sign * arc / dt_norm;
+        let mut du: Vec<Real> = dt.iter().map(|v| v * dlambda).collect();
+        let apply = |eq: &mut Self, du: &[Real], dlambda: Real| {
+            for (i, &dof) in eq.dofs.free.iter().enumerate() {
+                eq.u[dof] = u0[dof] + du[i];
+            }
+            eq.lambda = lambda0 + dlambda;
+        };
+        apply(self, &du, dlambda);
+        let mut last_step = arc;
+        let mut iterations = 1;
+        let mut internal = vec![0.0; nd];
+        loop {
+            let forces: Vec<Real> = reference.iter().map(|f| f * self.lambda).collect();
+            let r = self.out_of_balance(body, &self.u.clone(), &forces, &mut internal);
+            let scale = force_scale(&self.dofs, &forces, &internal).max(ref_norm);
+            let relative = norm(&r) / scale;
+            history.push(relative);
+            if !relative.is_finite() {
+                return Err(fail("the residual is not finite".to_string(), &history));
+            }
+            if relative <= settings.tolerance
+                && last_step <= settings.displacement_tolerance * norm(&self.u).max(arc)
+            {
+                self.previous = du;
+                self.residual_history = history;
+                return Ok(iterations);
+            }
+            if iterations >= settings.max_iterations {
+                return Err(fail(
+                    format!("no convergence in {} iterations", settings.max_iterations),
+                    &history,
+                ));
+            }
+            self.refactor(body)
+                .map_err(|reason| fail(reason, &history))?;
+            let mut dr = r;
+            self.solve(&mut dr);
+            let mut dt = ref_f.clone();
+            self.solve(&mut dt);
+            // |Δu + δu_R + δλ δu_t|² = arc²
+            let base: Vec<Real> = du.iter().zip(&dr).map(|(a, b)| a + b).collect();
+            let a = dot_product(&dt, &dt);
+            let b = 2.0 * dot_product(&dt, &base);
+            let c = dot_product(&base, &base) - arc * arc;
+            let disc = b * b - 4.0 * a * c;
+            if disc.is_nan() || disc < 0.0 || a == 0.0 {
+                return Err(fail(
+                    "the arc-length constraint has no real root (the increment is too long here)"
+                        .to_string(),
+                    &history,
+                ));
+            }
+            let q = -0.5 * (b + b.signum() * disc.sqrt());
+            let roots = [q / a, if q != 0.0 { c / q } else { q / a }];
+            let choose = |dl: Real| -> Real {
+                base.iter()
+                    .zip(&dt)
+                    .zip(&du)
+                    .map(|((x, t), d)| (x + dl * t) * d)
+                    .sum()
+            };
+            let dl = if choose(roots[0]) >= choose(roots[1]) {
+                roots[0]
+            } else {
+                roots[1]
+            };
+            let correction: Vec<Real> = dr.iter().zip(&dt).map(|(r, t)| r + dl * t).collect();
+            last_step = norm(&correction);
+            for (d, c) in du.iter_mut().zip(&correction) {
+                *d += c;
+            }
+            dlambda += dl;
+            apply(self, &du, dlambda);
+            iterations += 1;
+        }
+    }
+}
+
+/// The error for a step that could not be solved even with the smallest increment.
+fn not_converged(body: &Body, step: usize, cuts: usize, failure: IncrementFailure) -> SolveError {
+    SolveError::NotConverged {
+        body: body.name.clone(),
+        step,
+        cuts,
+        reason: failure.reason,
+        history: failure.history,
+    }
+}
+
+/// A schedule's factor at pseudo-time `t` (step units): linear between the factors of the
+/// steps around it, exact at whole steps.
+fn factor_at(schedule: &Schedule, t: Real, steps: usize) -> Real {
+    let k = t.ceil().max(1.0) as usize;
+    let f1 = schedule.factor(k, steps);
+    let f0 = schedule.factor(k - 1, steps);
+    let w = t - (k - 1) as Real;
+    if w >= 1.0 {
+        f1
+    } else {
+        f0 + w * (f1 - f0)
+    }
+}
+
+fn node_vector(u: &[Real], d: usize, node: usize) -> Vector3<Real> {
+    let mut v = Vector3::zeros();
+    for k in 0..d {
+        v[k] = u[node * d + k];
+    }
+    v
+}
+
+/// The response of member `m` at the displacement `u` (per body DOF).
+fn response(body: &Body, d: usize, u: &[Real], m: usize) -> MemberResponse {
+    let member = body.members[m];
+    let [a, b] = member.nodes;
+    member_response(
+        body.kinematics,
+        &body.materials[member.material],
+        &body.nodes[a],
+        &body.nodes[b],
+        &node_vector(u, d, a),
+        &node_vector(u, d, b),
+    )
+}
+
+/// The internal (member) force per body DOF at `u`, N: member `m` pushes its ends with
+/// `∓N n`.
+fn internal_forces(body: &Body, d: usize, u: &[Real], out: &mut [Real]) {
+    out.iter_mut().for_each(|v| *v = 0.0);
+    for m in 0..body.members.len() {
+        let r = response(body, d, u, m);
+        let [a, b] = body.members[m].nodes;
+        for k in 0..d {
+            out[a * d + k] -= r.force * r.axis[k];
+            out[b * d + k] += r.force * r.axis[k];
+        }
+    }
+}
+
+/// `K_T(u) v` over all body DOFs, member by member, N.
+fn tangent_times(body: &Body, d: usize, u: &[Real], v: &[Real], out: &mut [Real]) {
+    out.iter_mut().for_each(|x| *x = 0.0);
+    for m in 0..body.members.len() {
+        let [a, b] = body.members[m].nodes;
+        let dv = node_vector(v, d, b) - node_vector(v, d, a);
+        if dv == Vector3::zeros() {
+            continue;
+        }
+        let f = response(body, d, u, m).tangent * dv;
+        for k in 0..d {
+            out[a * d + k] -= f[k];
+            out[b * d + k] += f[k];
+        }
+    }
+}
+
+fn norm(v: &[Real]) -> Real {
+    v.iter().map(|x| x * x).sum::<Real>().sqrt()
+}
+
+fn dot_product(a: &[Real], b: &[Real]) -> Real {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn free_norm(dofs: &DofMap, forces: &[Real], internal: &[Real]) -> Real {
+    dofs.free
+        .iter()
+        .map(|&dof| (forces[dof] - internal[dof]).powi(2))
+        .sum::<Real>()
+        .sqrt()
+}

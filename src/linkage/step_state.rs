@@ -1,0 +1,133 @@
+//! The solved state of a body at one step, and its post-processing from a displacement field:
+//! shared by the linear solve ([`crate::linkage::Equilibrium`]) and the Newton solve.
+
+use crate::linkage::{Body, DofMap, DofSlot};
+use crate::Real;
+use nalgebra::Vector3;
+
+/// The solved state of a body at one load step.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepState {
+    /// Displacement of every node, m.
+    pub displacements: Vec<Vector3<Real>>,
+    /// Axial force of every member, N, tension positive.
+    pub axial_forces: Vec<Real>,
+    /// Engineering strain of every member (change of length over length), tension positive.
+    pub strains: Vec<Real>,
+    /// Axial stress of every member, Pa, tension positive (axial force over area).
+    pub stresses: Vec<Real>,
+    /// Members (0-based) whose stress is beyond their material's strength.
+    pub overloaded: Vec<usize>,
+    /// Per supported node (0-based), the force the supports exert on the body, N (paper Eq. 10).
+    pub reactions: Vec<(usize, Vector3<Real>)>,
+    /// Per loaded node (0-based), the applied force at this step, N.
+    pub loads: Vec<(usize, Vector3<Real>)>,
+    /// Out-of-balance force at the free DOFs over the largest of applied force and reaction
+    /// norms (0 when nothing is loaded).
+    pub residual: Real,
+    /// Equilibrium iterations this step took (1 for a linear step, Newton iterations otherwise).
+    pub iterations: usize,
+    /// How many times the step's load increment was halved because Newton did not converge.
+    pub cuts: usize,
+    /// The load factor the step reached when the path decides it (arc length); `None` when the
+    /// schedules decide it.
+    pub load_factor: Option<Real>,
+    /// Negative pivots of the tangent stiffness at the solution (0: stable; large kinematics only).
+    pub negative_pivots: usize,
+}
+
+/// Build the state from a displacement per body DOF `u` (m), the applied force per body DOF
+/// `forces` (N), the internal (member) force per body DOF `internal` (N) and each member's
+/// `(strain, axial force)`. Reactions are `internal − forces` at the supported DOFs (Eq. 10);
+/// the residual is `|internal − forces|` over the free DOFs relative to the larger of the
+/// applied force and reaction norms.
+pub(crate) fn post_process(
+    body: &Body,
+    dofs: &DofMap,
+    u: &[Real],
+    forces: &[Real],
+    internal: &[Real],
+    members: impl Iterator<Item = (Real, Real)>,
+) -> StepState {
+    let d = dofs.dofs_per_node;
+    let mut state = StepState {
+        displacements: (0..body.nodes.len())
+            .map(|i| {
+                let mut v = Vector3::zeros();
+                for k in 0..d {
+                    v[k] = u[i * d + k];
+                }
+                v
+            })
+            .collect(),
+        ..Default::default()
+    };
+    for ((strain, force), member) in members.zip(&body.members) {
+        let material = &body.materials[member.material];
+        let stress = force / material.area;
+        state.strains.push(strain);
+        state.stresses.push(stress);
+        state.axial_forces.push(force);
+        if material.is_overloaded(stress) {
+            state.overloaded.push(state.axial_forces.len() - 1);
+        }
+    }
+    let mut supported_node = vec![false; body.nodes.len()];
+    for &dof in &dofs.supported {
+        supported_node[dof / d] = true;
+    }
+    for (node, _) in supported_node.iter().enumerate().filter(|(_, s)| **s) {
+        let mut r = Vector3::zeros();
+        for k in 0..d {
+            if let DofSlot::Supported(_) = dofs.slots[node * d + k] {
+                r[k] = internal[node * d + k] - forces[node * d + k];
+            }
+        }
+        state.reactions.push((node, r));
+    }
+    let mut loaded = vec![false; body.nodes.len()];
+    for l in &body.loads {
+        loaded[l.node] = true;
+    }
+    for (node, _) in loaded.iter().enumerate().filter(|(_, l)| **l) {
+        let mut f = Vector3::zeros();
+        for k in 0..d {
+            f[k] = forces[node * d + k];
+        }
+        state.loads.push((node, f));
+    }
+    state.residual = relative_residual(dofs, forces, internal);
+    state
+}
+
+/// `|internal − forces|` over the free DOFs, relative to the larger of the norm of the applied
+/// forces and the norm of the reactions (`internal − forces` at the supported DOFs); 0 when
+/// both are zero.
+pub(crate) fn relative_residual(dofs: &DofMap, forces: &[Real], internal: &[Real]) -> Real {
+    let out_of_balance: Real = dofs
+        .free
+        .iter()
+        .map(|&dof| (internal[dof] - forces[dof]).powi(2))
+        .sum::<Real>()
+        .sqrt();
+    let scale = force_scale(dofs, forces, internal);
+    if scale > 0.0 {
+        out_of_balance / scale
+    } else if out_of_balance > 0.0 {
+        Real::INFINITY
+    } else {
+        0.0
+    }
+}
+
+/// The larger of the applied force norm and the reaction norm, N: what "relative" refers to.
+pub(crate) fn force_scale(dofs: &DofMap, forces: &[Real], internal: &[Real]) -> Real {
+    let applied = forces.iter().map(|f| f * f).sum::<Real>().sqrt();
+    let reacted = dofs
+        .supported
+        .iter()
+        .map(|&dof| (internal[dof] - forces[dof]).powi(2))
+        .sum::<Real>()
+        .sqrt();
+    applied.max(reacted)
+}

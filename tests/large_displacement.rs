@@ -1,0 +1,302 @@
+//! Large displacements: geometrically exact members solved by Newton (issue 4). Every check
+//! is against a closed form or an exact property, with its tolerance stated where it is used.
+
+use linkage::linkage::{
+    Behaviour, Body, BodySolver, Dimension, Kinematics, Material, Member, NewtonEquilibrium,
+    NodalLoad, PathMethod, Schedule, StepState, Support,
+};
+use nalgebra::Vector3;
+
+fn v(x: f64, y: f64) -> Vector3<f64> {
+    Vector3::new(x, y, 0.0)
+}
+
+fn bar(body: &mut Body, a: usize, b: usize, material: usize) {
+    body.members.push(Member {
+        nodes: [a, b],
+        material,
+    });
+}
+
+fn load(node: usize, force: Vector3<f64>) -> NodalLoad {
+    NodalLoad {
+        node,
+        force,
+        schedule: Schedule::Linear,
+    }
+}
+
+fn moved(node: usize, fixed: [bool; 3], displacement: Vector3<f64>) -> Support {
+    Support {
+        node,
+        fixed,
+        displacement,
+        schedule: Schedule::Linear,
+    }
+}
+
+/// Solve every step 1..=steps in order; return the states.
+fn solve_all(body: &Body, steps: usize) -> Vec<StepState> {
+    let solver = BodySolver::new(body).expect("solvable");
+    (1..=steps)
+        .map(|s| solver.solve_step(body, s, steps).expect("step converges"))
+        .collect()
+}
+
+// ---------------------------------------------------------------- the shallow two-bar truss
+
+/// Half span a, rise h, axial stiffness EA (E = 200 GPa, A = 1 cm²).
+const A: f64 = 1.0;
+const H: f64 = 0.1;
+const EA: f64 = 200e9 * 1e-4;
+
+/// Closed form of the von Mises truss with engineering strain: with the apex lowered by w,
+/// each bar has length l = √(a² + (h − w)²) and force N = EA (l − L)/L; the downward apex
+/// load in equilibrium is P = −2 N (h − w)/l.
+fn von_mises_load(w: f64) -> f64 {
+    let l0 = (A * A + H * H).sqrt();
+    let l = (A * A + (H - w) * (H - w)).sqrt();
+    -2.0 * EA * (l - l0) / l0 * (H - w) / l
+}
+
+/// The limit point: dP/dw = 0 on the rising branch, by bisection on a central difference
+/// slope (to 1e-13 in w; P is flat there, so its value is far more accurate).
+fn von_mises_limit() -> (f64, f64) {
+    let slope = |w: f64| (von_mises_load(w + 1e-7) - von_mises_load(w - 1e-7)) / 2e-7;
+    let (mut lo, mut hi) = (0.0, H);
+    while hi - lo > 1e-13 {
+        let mid = 0.5 * (lo + hi);
+        if slope(mid) > 0.0 {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    let w = 0.5 * (lo + hi);
+    (w, von_mises_load(w))
+}
+
+fn von_mises(load_factor: f64) -> Body {
+    let mut body = Body::new("von_mises", Dimension::Two);
+    body.materials.push(Material::new("steel", 200e9, 1e-4));
+    body.nodes = vec![v(-A, 0.0), v(0.0, H), v(A, 0.0)];
+    bar(&mut body, 0, 1, 0);
+    bar(&mut body, 1, 2, 0);
+    body.supports.push(Support::fixed(0, [true, true, false]));
+    body.supports.push(Support::fixed(2, [true, true, false]));
+    body.loads
+        .push(load(1, v(0.0, -load_factor * von_mises_limit().1)));
+    body.kinematics = Kinematics::Large;
+    body
+}
+
+/// Under load control up to 95 % of the limit load, every step lies on the closed-form curve:
+/// the applied load equals P(w) of the computed apex deflection to 1e-6 relative, and the
+/// apex does not move sideways.
+#[test]
+fn von_mises_truss_follows_closed_form_under_load_control() {
+    let body = von_mises(0.95);
+    let (_, limit) = von_mises_limit();
+    let steps = 5;
+    for (k, s) in solve_all(&body, steps).iter().enumerate() {
+        let applied = 0.95 * limit * (k + 1) as f64 / steps as f64;
+        let w = -s.displacements[1].y;
+        assert!(
+            (von_mises_load(w) - applied).abs() <= 1e-6 * applied,
+            "step {}: P(w) = {} against {applied}",
+            k + 1,
+            von_mises_load(w)
+        );
+        assert!(s.displacements[1].x.abs() <= 1e-9 * w);
+        assert!(s.residual <= 1e-8);
+        // Each bar carries N with 2 N sinθ = −P at the deformed angle.
+        let l = (A * A + (H - w) * (H - w)).sqrt();
+        let n = -applied * l / (2.0 * (H - w));
+        assert!((s.axial_forces[0] - n).abs() <= 1e-6 * n.abs());
+    }
+}
+
+// ---------------------------------------------------------------- exact kinematics
+
+/// A single bar stretched to twice its length by a prescribed end displacement: engineering
+/// strain ε = (2L − L)/L = 1, so N = EA (exact to 1e-12 relative), in one step or four.
+#[test]
+fn bar_stretched_to_twice_its_length() {
+    for steps in [1, 4] {
+        let l = 1.5;
+        let mut body = Body::new("bar", Dimension::Two);
+        body.materials.push(Material::new("rubber", 1e7, 1e-4));
+        // Inclined, so the direction is exercised too.
+        let dir = v(0.6, 0.8);
+        body.nodes = vec![v(0.0, 0.0), dir * l];
+        bar(&mut body, 0, 1, 0);
+        body.supports.push(Support::fixed(0, [true, true, false]));
+        body.supports.push(moved(1, [true, true, false], dir * l));
+        body.kinematics = Kinematics::Large;
+        let states = solve_all(&body, steps);
+        let s = states.last().unwrap();
+        let ea = 1e7 * 1e-4;
+        assert!((s.strains[0] - 1.0).abs() <= 1e-12);
+        assert!((s.axial_forces[0] - ea).abs() <= 1e-12 * ea);
+        // The support at the far end pulls outward with N along the bar.
+        let r = s.reactions.iter().find(|(n, _)| *n == 1).unwrap().1;
+        assert!((r - dir * ea).norm() <= 1e-9 * ea);
+    }
+}
+
+/// A triangulated square turned by 90° about its corner node 1 by prescribing nodes 1 and 2:
+/// nodes 3 and 4 follow as a rigid body, so `large` gives zero member forces (to 1e-9 of
+/// EA) and the free nodes land on their rotated places, while `linear` stretches members.
+#[test]
+fn rigid_rotation_by_90_degrees_causes_no_force() {
+    let mut body = Body::new("square", Dimension::Two);
+    body.materials.push(Material::new("steel", 200e9, 1e-4));
+    body.nodes = vec![v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.0, 1.0)];
+    for (a, b) in [(0, 1), (1, 2), (2, 3), (3, 0), (0, 2), (1, 3)] {
+        bar(&mut body, a, b, 0);
+    }
+    // Rotation by +90° about node 1: p ↦ (−p_y, p_x).
+    let rotated = |p: Vector3<f64>| v(-p.y, p.x);
+    body.supports.push(Support::fixed(0, [true, true, false]));
+    body.supports.push(moved(
+        1,
+        [true, true, false],
+        rotated(body.nodes[1]) - body.nodes[1],
+    ));
+    body.kinematics = Kinematics::Large;
+    let steps = 6;
+    let s = solve_all(&body, steps).pop().unwrap();
+    let ea = 200e9 * 1e-4;
+    for (m, n) in s.axial_forces.iter().enumerate() {
+        assert!(n.abs() <= 1e-9 * ea, "member {}: {n}", m + 1);
+    }
+    for i in 2..4 {
+        let place = body.nodes[i] + s.displacements[i];
+        assert!(
+            (place - rotated(body.nodes[i])).norm() <= 1e-9,
+            "node {}",
+            i + 1
+        );
+    }
+    body.kinematics = Kinematics::Linear;
+    let linear = solve_all(&body, 1).pop().unwrap();
+    let largest = linear
+        .axial_forces
+        .iter()
+        .fold(0.0f64, |m, n| m.max(n.abs()));
+    assert!(
+        largest > 0.1 * ea,
+        "the linear model stretches members: {largest}"
+    );
+}
+
+/// A slender cantilever truss (10 × 1 cells) under a tip load large enough to bend it far:
+/// the end state does not depend on how many load steps lead there (to 1e-6 of the tip
+/// deflection), and Newton converges quadratically near the solution.
+#[test]
+fn conservative_load_is_independent_of_the_steps_and_newton_is_quadratic() {
+    let body = cantilever(Kinematics::Large);
+    let one = solve_all(&body, 1).pop().unwrap();
+    let eight = solve_all(&body, 8).pop().unwrap();
+    let tip = body.nodes.len() - 1;
+    let scale = eight.displacements[tip].norm();
+    let linear = solve_all(&cantilever(Kinematics::Linear), 1).pop().unwrap();
+    // The load is large: linear and large kinematics differ by far more than 10 %.
+    assert!((linear.displacements[tip] - eight.displacements[tip]).norm() > 0.1 * scale);
+    for (a, b) in one.displacements.iter().zip(&eight.displacements) {
+        assert!((a - b).norm() <= 1e-6 * scale, "{a} vs {b}");
+    }
+
+    let mut newton = NewtonEquilibrium::new(&body).unwrap();
+    newton.solve_step(&body, 1, 1).unwrap();
+    let r = &newton.residual_history;
+    eprintln!("relative residuals of the last increment: {r:?}");
+    // Quadratic: once below 1e-2, each residual is at most about the square of the one
+    // before (C r², C = 100), until round-off (1e-13) is reached.
+    let mut checked = 0;
+    for w in r.windows(2) {
+        if w[0] < 1e-2 && w[0] > 1e-7 {
+            assert!(w[1] <= 100.0 * w[0] * w[0], "{:e} -> {:e}", w[0], w[1]);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 1, "no iteration in the quadratic range: {r:?}");
+}
+
+fn cantilever(kinematics: Kinematics) -> Body {
+    // Nodes: bottom row 0..=10, top row 11..=21, at 0.1 m spacing; the left end clamped.
+    let (cells, h) = (10, 0.1);
+    let mut body = Body::new("cantilever", Dimension::Two);
+    body.materials.push(Material::new("steel", 200e9, 1e-5));
+    for row in 0..2 {
+        for i in 0..=cells {
+            body.nodes.push(v(i as f64 * h, row as f64 * h));
+        }
+    }
+    let top = cells + 1;
+    for i in 0..cells {
+        bar(&mut body, i, i + 1, 0);
+        bar(&mut body, top + i, top + i + 1, 0);
+        bar(&mut body, i + 1, top + i + 1, 0);
+        bar(&mut body, i, top + i + 1, 0);
+    }
+    bar(&mut body, 0, top, 0);
+    body.supports.push(Support::fixed(0, [true, true, false]));
+    body.supports.push(Support::fixed(top, [true, true, false]));
+    body.loads.push(load(body.nodes.len() - 1, v(0.0, -6e3)));
+    body.kinematics = kinematics;
+    body
+}
+
+// ---------------------------------------------------------------- cables
+
+/// A node held by a steel bar and a cable, pushed toward the cable's anchor: the cable goes
+/// slack and carries exactly no force; the bar carries the whole load. Pulled the other way,
+/// the two share it by stiffness.
+#[test]
+fn slack_cable_carries_no_force() {
+    let build = |push: f64| {
+        let mut body = Body::new("guy", Dimension::Two);
+        body.materials.push(Material::new("steel", 200e9, 1e-4));
+        let mut cable = Material::new("cable", 200e9, 1e-4);
+        cable.behaviour = Behaviour::TensionOnly;
+        body.materials.push(cable);
+        body.nodes = vec![v(0.0, 0.0), v(1.0, 0.0), v(2.0, 0.0)];
+        bar(&mut body, 0, 1, 0);
+        bar(&mut body, 1, 2, 1);
+        body.supports.push(Support::fixed(0, [true, true, false]));
+        body.supports.push(Support::fixed(1, [false, true, false]));
+        body.supports.push(Support::fixed(2, [true, true, false]));
+        body.loads.push(load(1, v(push, 0.0)));
+        body
+    };
+    // Pushing node 2 toward node 3 stretches the bar and shortens the cable.
+    for kinematics in [Kinematics::Linear, Kinematics::Large] {
+        let mut body = build(1000.0);
+        body.kinematics = kinematics;
+        let s = solve_all(&body, 2).pop().unwrap();
+        assert_eq!(
+            s.axial_forces[1], 0.0,
+            "{kinematics:?}: the slack cable carries nothing"
+        );
+        assert!(s.strains[1] < 0.0);
+        assert!((s.axial_forces[0] - 1000.0).abs() <= 1e-6 * 1000.0);
+        let mut body = build(-1000.0);
+        body.kinematics = kinematics;
+        let s = solve_all(&body, 2).pop().unwrap();
+        // Pulling back: the bar is compressed and the cable stretched, equal stiffness.
+        assert!(
+            (s.axial_forces[1] - 500.0).abs() <= 1e-4 * 500.0,
+            "{kinematics:?}: {:?}",
+            s.axial_forces
+        );
+        assert!((s.axial_forces[0] + 500.0).abs() <= 1e-4 * 500.0);
+    }
+}
+
+#[test]
+fn arc_length_path_setting_is_checked() {
+    let mut body = von_mises(1.0);
+    body.newton.path = PathMethod::ArcLength { length: -1.0 };
+    assert!(BodySolver::new(&body).is_err());
+}
