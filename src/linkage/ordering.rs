@@ -1,1 +1,498 @@
-//! Fill-reducing orderings (placeholder: being written).
+//! Fill-reducing orderings: METIS nested dissection of a graph, and its expansion from nodes to DOFs.
+//!
+//! Permutations follow faer's convention: `perm[new] = old` and `inv[old] = new`.
+
+use metis_sys::idx_t;
+
+/// Why an ordering could not be computed.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum OrderingError {
+    /// The graph arrays are malformed (lengths, offsets or vertex indices out of range).
+    #[error("invalid graph: {0}")]
+    InvalidGraph(String),
+    /// The graph does not fit METIS's index type (`idx_t`, 32 bits in the vendored build).
+    #[error("graph too large for METIS: {what} = {value} exceeds the {bits}-bit index limit")]
+    TooLarge {
+        /// Which quantity overflowed ("vertices" or "adjacency entries").
+        what: &'static str,
+        /// Its value.
+        value: usize,
+        /// Width of METIS's `idx_t`.
+        bits: u32,
+    },
+    /// METIS returned an error status.
+    #[error("METIS_NodeND failed with status {status} ({meaning})")]
+    Metis {
+        /// The raw status code (`METIS_ERROR_INPUT` = −2, `METIS_ERROR_MEMORY` = −3, `METIS_ERROR` = −4).
+        status: i32,
+        /// A short reading of the status.
+        meaning: &'static str,
+    },
+    /// The DOF → node map does not fit the node ordering.
+    #[error("invalid DOF groups: {0}")]
+    InvalidGroups(String),
+}
+
+/// Nested-dissection ordering of a graph given as CSR adjacency (`xadj` of length
+/// `n + 1`, neighbours of vertex `v` in `adjncy[xadj[v]..xadj[v + 1]]`).
+///
+/// The graph should be symmetric without self loops; it is symmetrized and cleaned
+/// (self loops and duplicate edges dropped) before it reaches METIS anyway, because
+/// METIS does not check its input and could read out of bounds on an asymmetric graph.
+/// Returns `(perm, inv)` with `perm[new] = old` and `inv[old] = new`.
+pub fn nested_dissection(
+    xadj: &[usize],
+    adjncy: &[usize],
+) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
+    let n = check_csr(xadj, adjncy)?;
+    let mut graph = MetisGraph::new(n, xadj, adjncy)?;
+    // No edges: every order is fill-free, and METIS gains nothing.
+    if n <= 1 || graph.adjncy.is_empty() {
+        let identity: Vec<usize> = (0..n).collect();
+        return Ok((identity.clone(), identity));
+    }
+    let (perm, inv) = metis_node_nd(&mut graph)?;
+    let perm: Vec<usize> = perm.iter().map(|&p| p as usize).collect();
+    let inv: Vec<usize> = inv.iter().map(|&p| p as usize).collect();
+    // A wrong permutation from C would corrupt the factorization silently: check it once.
+    if !is_inverse_pair(&perm, &inv) {
+        return Err(OrderingError::Metis {
+            status: 1,
+            meaning: "returned an invalid permutation",
+        });
+    }
+    Ok((perm, inv))
+}
+
+/// Node adjacency graph (CSR, symmetric, no self loops, no duplicates) of a symmetric
+/// sparsity pattern stored as CSC (`col_ptr` of length `n + 1`, any triangle or both).
+///
+/// With `groups = Some(map)` (`map[dof] = node`, `n_nodes` nodes) two nodes are adjacent
+/// when any of their DOFs couple, i.e. the quotient graph; with `None` the vertices are
+/// the `n` DOFs themselves and `n_nodes` must be `n`. Returns `(xadj, adjncy)`.
+pub fn graph_of_pattern(
+    n: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    groups: Option<&[usize]>,
+    n_nodes: usize,
+) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
+    let cols = check_csr(col_ptr, row_idx)?;
+    if cols != n {
+        return Err(OrderingError::InvalidGraph(format!(
+            "col_ptr has {} entries for {n} columns",
+            col_ptr.len()
+        )));
+    }
+    let vertex_of = |dof: usize| groups.map_or(dof, |g| g[dof]);
+    match groups {
+        Some(g) => check_groups(g, n, n_nodes)?,
+        None if n_nodes != n => {
+            return Err(OrderingError::InvalidGroups(format!(
+                "without groups the graph has {n} vertices, not {n_nodes}"
+            )))
+        }
+        None => {}
+    }
+    // One pass builds, per vertex, the coupled vertices seen in its own columns (each
+    // column's entries are scattered through a marker so every pair is kept once per
+    // column group); `symmetrize` then adds the other direction.
+    let members = group_members(n, n_nodes, &vertex_of);
+    let mut marker = vec![usize::MAX; n_nodes];
+    let mut hx = Vec::with_capacity(n_nodes + 1);
+    let mut ha = Vec::new();
+    hx.push(0);
+    for (v, dofs) in members.1.windows(2).enumerate() {
+        marker[v] = v;
+        for &j in &members.0[dofs[0]..dofs[1]] {
+            for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                let u = vertex_of(i);
+                if marker[u] != v {
+                    marker[u] = v;
+                    ha.push(u);
+                }
+            }
+        }
+        hx.push(ha.len());
+    }
+    Ok(symmetrize(n_nodes, &hx, &ha))
+}
+
+/// Expands a node ordering to a DOF ordering: the DOFs of each node follow each other
+/// in the node's position, in ascending DOF order, whether or not they were consecutive
+/// before. `node_perm[new] = old node`, `groups[dof] = node`; nodes without DOFs (fully
+/// supported) are simply skipped. Returns `(perm, inv)` over DOFs.
+pub fn expand_to_dofs(
+    node_perm: &[usize],
+    groups: &[usize],
+) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
+    let n_nodes = node_perm.len();
+    let n = groups.len();
+    check_groups(groups, n, n_nodes)?;
+    let mut node_inv = vec![usize::MAX; n_nodes];
+    for (new, &old) in node_perm.iter().enumerate() {
+        if old >= n_nodes || node_inv[old] != usize::MAX {
+            return Err(OrderingError::InvalidGroups(
+                "node ordering is not a permutation".into(),
+            ));
+        }
+        node_inv[old] = new;
+    }
+    // Counting sort of the DOFs by their node's new position keeps ascending DOF order
+    // within a node because DOFs are visited in ascending order.
+    let mut start = vec![0usize; n_nodes + 1];
+    for &node in groups {
+        start[node_inv[node] + 1] += 1;
+    }
+    for k in 0..n_nodes {
+        start[k + 1] += start[k];
+    }
+    let mut perm = vec![0usize; n];
+    for (dof, &node) in groups.iter().enumerate() {
+        let slot = &mut start[node_inv[node]];
+        perm[*slot] = dof;
+        *slot += 1;
+    }
+    let mut inv = vec![0usize; n];
+    for (new, &old) in perm.iter().enumerate() {
+        inv[old] = new;
+    }
+    Ok((perm, inv))
+}
+
+/// A graph METIS may safely read: symmetric, no self loops or duplicate edges, offsets
+/// and indices valid, all in METIS's index type. Only [`MetisGraph::new`] builds one.
+struct MetisGraph {
+    xadj: Vec<idx_t>,
+    adjncy: Vec<idx_t>,
+}
+
+impl MetisGraph {
+    /// Cleans a checked CSR graph (see [`check_csr`]) and converts it to `idx_t`.
+    fn new(n: usize, xadj: &[usize], adjncy: &[usize]) -> Result<Self, OrderingError> {
+        idx_t::try_from(n).map_err(|_| too_large("vertices", n))?;
+        let (sx, sa) = symmetrize(n, xadj, adjncy);
+        Ok(Self {
+            xadj: to_idx(&sx, "adjacency entries")?,
+            adjncy: to_idx(&sa, "vertices")?,
+        })
+    }
+}
+
+/// Calls `METIS_NodeND` with default options and returns its `(perm, iperm)`.
+///
+/// This is the crate's only `unsafe`. Its soundness rests on [`MetisGraph`]: METIS does
+/// not validate its input, so it only ever sees a graph built by `MetisGraph::new`.
+fn metis_node_nd(graph: &mut MetisGraph) -> Result<(Vec<idx_t>, Vec<idx_t>), OrderingError> {
+    let n = graph.xadj.len() - 1;
+    let mut nvtxs = idx_t::try_from(n).map_err(|_| too_large("vertices", n))?;
+    let mut perm: Vec<idx_t> = vec![0; n];
+    let mut iperm: Vec<idx_t> = vec![0; n];
+    // SAFETY: `nvtxs` is the vertex count, `xadj` has `nvtxs + 1` offsets ending at
+    // `adjncy.len()`, every neighbour is a valid vertex and the graph is symmetric
+    // without self loops (all by construction of `MetisGraph`); `perm` and `iperm` hold
+    // `nvtxs` entries each; null `vwgt` and `options` select unit weights and METIS's
+    // defaults (0-based numbering). METIS keeps no pointer after returning.
+    let status = unsafe {
+        metis_sys::METIS_NodeND(
+            &mut nvtxs,
+            graph.xadj.as_mut_ptr(),
+            graph.adjncy.as_mut_ptr(),
+            std::ptr::null_mut(),
+            std::ptr::null_mut(),
+            perm.as_mut_ptr(),
+            iperm.as_mut_ptr(),
+        )
+    };
+    if status == metis_sys::rstatus_et_METIS_OK {
+        Ok((perm, iperm))
+    } else {
+        let meaning = match status {
+            metis_sys::rstatus_et_METIS_ERROR_INPUT => "erroneous input",
+            metis_sys::rstatus_et_METIS_ERROR_MEMORY => "out of memory",
+            _ => "internal error",
+        };
+        Err(OrderingError::Metis { status, meaning })
+    }
+}
+
+fn too_large(what: &'static str, value: usize) -> OrderingError {
+    OrderingError::TooLarge {
+        what,
+        value,
+        bits: idx_t::BITS,
+    }
+}
+
+fn to_idx(v: &[usize], what: &'static str) -> Result<Vec<idx_t>, OrderingError> {
+    // The largest entry decides; the conversion below can then not wrap.
+    let max = v.iter().copied().max().unwrap_or(0);
+    if idx_t::try_from(max).is_err() {
+        return Err(too_large(what, max));
+    }
+    Ok(v.iter().map(|&x| x as idx_t).collect())
+}
+
+/// Checks CSR/CSC offsets and indices and returns the number of rows (vertices).
+fn check_csr(ptr: &[usize], idx: &[usize]) -> Result<usize, OrderingError> {
+    let Some(n) = ptr.len().checked_sub(1) else {
+        return Err(OrderingError::InvalidGraph(
+            "offset array is empty (need n + 1 entries)".into(),
+        ));
+    };
+    if ptr[0] != 0 || ptr[n] != idx.len() {
+        return Err(OrderingError::InvalidGraph(format!(
+            "offsets must run from 0 to {} (found {} to {})",
+            idx.len(),
+            ptr[0],
+            ptr[n]
+        )));
+    }
+    if let Some(v) = ptr.windows(2).position(|w| w[0] > w[1]) {
+        return Err(OrderingError::InvalidGraph(format!(
+            "offsets decrease at vertex {v}"
+        )));
+    }
+    if let Some(&bad) = idx.iter().find(|&&i| i >= n) {
+        return Err(OrderingError::InvalidGraph(format!(
+            "index {bad} out of range for {n} vertices"
+        )));
+    }
+    Ok(n)
+}
+
+fn check_groups(groups: &[usize], n: usize, n_nodes: usize) -> Result<(), OrderingError> {
+    if groups.len() != n {
+        return Err(OrderingError::InvalidGroups(format!(
+            "{} group entries for {n} DOFs",
+            groups.len()
+        )));
+    }
+    if let Some(dof) = groups.iter().position(|&g| g >= n_nodes) {
+        return Err(OrderingError::InvalidGroups(format!(
+            "DOF {dof} belongs to node {} of {n_nodes}",
+            groups[dof]
+        )));
+    }
+    Ok(())
+}
+
+/// The DOFs of each vertex as CSR (`(dofs, offsets)`), DOFs ascending within a vertex.
+fn group_members(
+    n: usize,
+    n_nodes: usize,
+    vertex_of: &impl Fn(usize) -> usize,
+) -> (Vec<usize>, Vec<usize>) {
+    let mut start = vec![0usize; n_nodes + 1];
+    for dof in 0..n {
+        start[vertex_of(dof) + 1] += 1;
+    }
+    for k in 0..n_nodes {
+        start[k + 1] += start[k];
+    }
+    let mut next = start.clone();
+    let mut dofs = vec![0usize; n];
+    for dof in 0..n {
+        let slot = &mut next[vertex_of(dof)];
+        dofs[*slot] = dof;
+        *slot += 1;
+    }
+    (dofs, start)
+}
+
+/// Union of a graph and its transpose, without self loops and duplicate edges
+/// (neighbour lists come out in no particular order). Indices must be valid.
+fn symmetrize(n: usize, xadj: &[usize], adjncy: &[usize]) -> (Vec<usize>, Vec<usize>) {
+    let mut deg = vec![0usize; n + 1];
+    for v in 0..n {
+        for &u in &adjncy[xadj[v]..xadj[v + 1]] {
+            if u != v {
+                deg[u + 1] += 1;
+                deg[v + 1] += 1;
+            }
+        }
+    }
+    for k in 0..n {
+        deg[k + 1] += deg[k];
+    }
+    let mut next = deg.clone();
+    let mut both = vec![0usize; deg[n]];
+    for v in 0..n {
+        for &u in &adjncy[xadj[v]..xadj[v + 1]] {
+            if u != v {
+                both[next[v]] = u;
+                next[v] += 1;
+                both[next[u]] = v;
+                next[u] += 1;
+            }
+        }
+    }
+    // Compact in place: the write cursor never passes the read cursor.
+    let mut marker = vec![usize::MAX; n];
+    let mut out_ptr = Vec::with_capacity(n + 1);
+    out_ptr.push(0);
+    let mut w = 0;
+    for v in 0..n {
+        for r in deg[v]..deg[v + 1] {
+            let u = both[r];
+            if marker[u] != v {
+                marker[u] = v;
+                both[w] = u;
+                w += 1;
+            }
+        }
+        out_ptr.push(w);
+    }
+    both.truncate(w);
+    (out_ptr, both)
+}
+
+fn is_inverse_pair(perm: &[usize], inv: &[usize]) -> bool {
+    perm.len() == inv.len()
+        && perm
+            .iter()
+            .enumerate()
+            .all(|(new, &old)| old < inv.len() && inv[old] == new)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 4-neighbour grid graph of nx × ny vertices.
+    fn grid(nx: usize, ny: usize) -> (Vec<usize>, Vec<usize>) {
+        let mut xadj = vec![0];
+        let mut adj = Vec::new();
+        for y in 0..ny {
+            for x in 0..nx {
+                if x > 0 {
+                    adj.push(y * nx + x - 1);
+                }
+                if x + 1 < nx {
+                    adj.push(y * nx + x + 1);
+                }
+                if y > 0 {
+                    adj.push((y - 1) * nx + x);
+                }
+                if y + 1 < ny {
+                    adj.push((y + 1) * nx + x);
+                }
+                xadj.push(adj.len());
+            }
+        }
+        (xadj, adj)
+    }
+
+    fn assert_perm_pair(perm: &[usize], inv: &[usize], n: usize) {
+        assert_eq!(perm.len(), n);
+        let mut seen = vec![false; n];
+        for &p in perm {
+            assert!(!seen[p]);
+            seen[p] = true;
+        }
+        assert!(is_inverse_pair(perm, inv));
+    }
+
+    #[test]
+    fn metis_node_nd_orders_a_grid() {
+        let (xadj, adj) = grid(7, 5);
+        let mut graph = MetisGraph::new(35, &xadj, &adj).unwrap();
+        let (perm, iperm) = metis_node_nd(&mut graph).unwrap();
+        let perm: Vec<usize> = perm.iter().map(|&p| p as usize).collect();
+        let iperm: Vec<usize> = iperm.iter().map(|&p| p as usize).collect();
+        assert_perm_pair(&perm, &iperm, 35);
+        // METIS must leave the graph as it found it (0-based numbering in and out).
+        assert_eq!(graph.xadj.len(), 36);
+        assert_eq!(graph.xadj[35] as usize, adj.len());
+    }
+
+    #[test]
+    fn nested_dissection_of_grid_is_a_permutation() {
+        let (xadj, adj) = grid(20, 13);
+        let (perm, inv) = nested_dissection(&xadj, &adj).unwrap();
+        assert_perm_pair(&perm, &inv, 260);
+        // Nested dissection puts a separator last: it is not the identity.
+        assert_ne!(perm, (0..260).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn nested_dissection_trivial_cases() {
+        assert_eq!(nested_dissection(&[0], &[]).unwrap(), (vec![], vec![]));
+        assert_eq!(nested_dissection(&[0, 0], &[]).unwrap(), (vec![0], vec![0]));
+        let (p, i) = nested_dissection(&[0, 0, 0, 0], &[]).unwrap();
+        assert_eq!((p, i), (vec![0, 1, 2], vec![0, 1, 2]));
+        // Only a self loop: no edges after cleaning.
+        let (p, _) = nested_dissection(&[0, 1, 1], &[0]).unwrap();
+        assert_eq!(p, vec![0, 1]);
+    }
+
+    #[test]
+    fn nested_dissection_rejects_bad_graphs() {
+        assert!(matches!(
+            nested_dissection(&[], &[]),
+            Err(OrderingError::InvalidGraph(_))
+        ));
+        assert!(matches!(
+            nested_dissection(&[0, 1, 2], &[1, 5]),
+            Err(OrderingError::InvalidGraph(_))
+        ));
+        assert!(matches!(
+            nested_dissection(&[0, 2, 1], &[1, 0]),
+            Err(OrderingError::InvalidGraph(_))
+        ));
+    }
+
+    #[test]
+    fn one_sided_graph_is_symmetrized() {
+        // Path 0-1-2-3-4 given in one direction only, with a duplicate.
+        let (xadj, adj) = (vec![0, 2, 3, 4, 5, 5], vec![1, 1, 2, 3, 4]);
+        let (sx, sa) = symmetrize(5, &xadj, &adj);
+        let mut rows: Vec<Vec<usize>> = (0..5).map(|v| sa[sx[v]..sx[v + 1]].to_vec()).collect();
+        rows.iter_mut().for_each(|r| r.sort_unstable());
+        assert_eq!(
+            rows,
+            vec![vec![1], vec![0, 2], vec![1, 3], vec![2, 4], vec![3]]
+        );
+        let (perm, inv) = nested_dissection(&xadj, &adj).unwrap();
+        assert_perm_pair(&perm, &inv, 5);
+    }
+
+    #[test]
+    fn expansion_keeps_node_dofs_together() {
+        // 4 nodes, node 2 fully supported (no DOFs); DOFs of node 0 interleaved.
+        let groups = [0, 1, 0, 3, 3, 1, 0];
+        let node_perm = [3, 0, 2, 1];
+        let (perm, inv) = expand_to_dofs(&node_perm, &groups).unwrap();
+        assert_perm_pair(&perm, &inv, 7);
+        assert_eq!(perm, vec![3, 4, 0, 2, 6, 1, 5]);
+        assert!(expand_to_dofs(&[0, 0], &[0, 1]).is_err());
+        assert!(expand_to_dofs(&[0, 1], &[0, 2]).is_err());
+    }
+
+    #[test]
+    fn quotient_graph_of_lower_pattern() {
+        // 3 nodes × 2 DOFs on a path: node blocks (0,1)-(2,3)-(4,5), lower triangle.
+        let cols: Vec<Vec<usize>> = vec![
+            vec![0, 1, 2, 3],
+            vec![1, 2, 3],
+            vec![2, 3, 4, 5],
+            vec![3, 4, 5],
+            vec![4, 5],
+            vec![5],
+        ];
+        let mut col_ptr = vec![0];
+        let mut row_idx = Vec::new();
+        for c in &cols {
+            row_idx.extend_from_slice(c);
+            col_ptr.push(row_idx.len());
+        }
+        let groups = [0, 0, 1, 1, 2, 2];
+        let (x, a) = graph_of_pattern(6, &col_ptr, &row_idx, Some(&groups), 3).unwrap();
+        let mut rows: Vec<Vec<usize>> = (0..3).map(|v| a[x[v]..x[v + 1]].to_vec()).collect();
+        rows.iter_mut().for_each(|r| r.sort_unstable());
+        assert_eq!(rows, vec![vec![1], vec![0, 2], vec![1]]);
+        let (x, a) = graph_of_pattern(6, &col_ptr, &row_idx, None, 6).unwrap();
+        assert_eq!(x.len(), 7);
+        assert_eq!(a.len(), 2 * (row_idx.len() - 6));
+    }
+}
