@@ -300,3 +300,72 @@ fn arc_length_path_setting_is_checked() {
     body.newton.path = PathMethod::ArcLength { length: -1.0 };
     assert!(BodySolver::new(&body).is_err());
 }
+
+/// The arc-length method traces the whole path of the shallow two-bar truss: up to the limit
+/// point, down the falling branch through zero load (the bars flat) to negative loads, and
+/// back up past the inverted position. Every traced point lies on the closed-form curve to
+/// 1e-6 of the limit load; the tangent has one negative pivot exactly on the falling branch;
+/// and the limit load, from a parabola through the three highest points, matches the closed
+/// form to 1e-6.
+#[test]
+fn von_mises_truss_snap_through_by_arc_length() {
+    let mut body = von_mises(1.0);
+    let (w_limit, limit) = von_mises_limit();
+    let steps = 80;
+    body.newton.path = PathMethod::ArcLength { length: 0.004 };
+    let states = solve_all(&body, steps);
+    let mut trace = vec![(0.0, 0.0)];
+    for (k, s) in states.iter().enumerate() {
+        let w = -s.displacements[1].y;
+        let lambda = s.load_factor.expect("arc length reports its load factor");
+        assert!(
+            (lambda * limit - von_mises_load(w)).abs() <= 1e-6 * limit,
+            "step {}: w = {w}, λP = {}, P(w) = {}",
+            k + 1,
+            lambda * limit,
+            von_mises_load(w)
+        );
+        // Unstable exactly between the two limit points (where dP/dw < 0).
+        let slope = von_mises_load(w + 1e-7) - von_mises_load(w - 1e-7);
+        if slope.abs() > 1e-6 * limit {
+            assert_eq!(
+                s.negative_pivots,
+                usize::from(slope < 0.0),
+                "step {}: w = {w}",
+                k + 1
+            );
+        }
+        trace.push((w, lambda));
+    }
+    let last = trace.last().unwrap();
+    assert!(
+        last.0 > 2.0 * H,
+        "traced past the inverted position: w = {}",
+        last.0
+    );
+    assert!(
+        trace.iter().any(|&(w, l)| w > H && l < -0.5),
+        "the falling branch reaches negative loads"
+    );
+    // Limit load: traced again with a ten times shorter arc up to just past the limit, then
+    // the vertex of the parabola through the first local maximum of λ and its neighbours
+    // (past the inverted position λ rises again without bound).
+    body.newton.path = PathMethod::ArcLength { length: 0.0004 };
+    let fine = solve_all(&body, 120);
+    let trace: Vec<(f64, f64)> = fine
+        .iter()
+        .map(|s| (-s.displacements[1].y, s.load_factor.unwrap()))
+        .collect();
+    let top = (1..trace.len() - 1)
+        .find(|&i| trace[i].1 >= trace[i - 1].1 && trace[i].1 >= trace[i + 1].1)
+        .expect("a limit point");
+    let [(x0, y0), (x1, y1), (x2, y2)] = [trace[top - 1], trace[top], trace[top + 1]];
+    let d01 = (y1 - y0) / (x1 - x0);
+    let d12 = (y2 - y1) / (x2 - x1);
+    let a = (d12 - d01) / (x2 - x0);
+    let b = d01 - a * (x0 + x1);
+    let w_peak = -b / (2.0 * a);
+    let peak = a * w_peak * w_peak + b * w_peak + (y0 - a * x0 * x0 - b * x0);
+    eprintln!("limit: traced λ = {peak:.9} at w = {w_peak:.6}; closed form 1 at w = {w_limit:.6}");
+    assert!((peak - 1.0).abs() <= 1e-6, "limit load {peak} against 1");
+}

@@ -6,19 +6,19 @@ use std::sync::Mutex;
 /// One body's equilibrium solver, chosen by [`Body::is_nonlinear`].
 pub enum BodySolver {
     /// Linear kinematics and elastic members: factor once, superpose load patterns.
-    Linear(Equilibrium),
+    Linear(Box<Equilibrium>),
     /// Large kinematics, cables or struts, or an arc-length path: Newton step by step. The
     /// lock holds the current state so steps can be asked for through a shared reference.
-    Nonlinear(Mutex<NewtonEquilibrium>),
+    Nonlinear(Box<Mutex<NewtonEquilibrium>>),
 }
 
 impl BodySolver {
     /// Validate `body` and prepare its solver (for a linear body: solve it).
     pub fn new(body: &Body) -> Result<Self, SolveError> {
         Ok(if body.is_nonlinear() {
-            BodySolver::Nonlinear(Mutex::new(NewtonEquilibrium::new(body)?))
+            BodySolver::Nonlinear(Box::new(Mutex::new(NewtonEquilibrium::new(body)?)))
         } else {
-            BodySolver::Linear(Equilibrium::new(body)?)
+            BodySolver::Linear(Box::new(Equilibrium::new(body)?))
         })
     }
 

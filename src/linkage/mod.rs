@@ -27,6 +27,7 @@ mod equilibrium;
 pub mod generators;
 mod geometry;
 mod kinematics;
+pub mod ldlt;
 mod material;
 mod mechanism;
 mod member_response;

@@ -86,7 +86,10 @@ impl NewtonEquilibrium {
             eq.times.symbolic += t.elapsed().as_secs_f64();
             eq.solver = Some(solver);
             let t = Instant::now();
-            let first = eq.factorize();
+            let first = match eq.solver.as_mut() {
+                Some(s) => s.factorize_definite(&eq.values),
+                None => Ok(()),
+            };
             eq.times.numeric += t.elapsed().as_secs_f64();
             match first {
                 Ok(_) => {}
@@ -246,7 +249,7 @@ impl NewtonEquilibrium {
         let Some(solver) = self.solver.as_mut() else {
             return Ok(0);
         };
-        let negative = solver.factorize(&self.values)?;
+        let negative = solver.factorize(&self.assembly, &self.values)?;
         self.negative_pivots = negative;
         Ok(negative)
     }
