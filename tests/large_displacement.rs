@@ -369,3 +369,70 @@ fn von_mises_truss_snap_through_by_arc_length() {
     eprintln!("limit: traced λ = {peak:.9} at w = {w_peak:.6}; closed form 1 at w = {w_limit:.6}");
     assert!((peak - 1.0).abs() <= 1e-6, "limit load {peak} against 1");
 }
+
+/// Under load control a load beyond the limit point has no nearby equilibrium: the step that
+/// passes it fails after its halvings with an error naming the body, the step and the
+/// residuals; the steps before it are written and summary.json states the failure.
+#[test]
+fn load_beyond_the_limit_point_stops_with_the_solved_steps_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let here = std::env::current_dir().unwrap().join("scenes");
+    let scene = dir.path().join("overload.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "overload"
+steps = 4
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "truss"
+nodes = "{}"
+links = "{}"
+kinematics = "large"
+[bodies.newton]
+max_cuts = 3
+[[bodies.supports]]
+nodes = [1, 3]
+fix = ["x", "y"]
+[[bodies.loads]]
+nodes = [2]
+force = [0.0, -9000.0]   # 1.18 times the limit load (7622 N)
+"#,
+            here.join("von_mises.nodes").display(),
+            here.join("von_mises.links").display()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_linkage"))
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!run.status.success());
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        stdout.contains("body 'truss': step 4 did not converge after 3 halvings"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("relative residuals of the last attempt"),
+        "{stdout}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("overload/summary.json")).unwrap()).unwrap();
+    let steps = summary["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 4, "steps 0 to 3 were solved");
+    assert!(summary["failure"].as_str().unwrap().contains("step 4"));
+    for s in &steps[1..] {
+        assert_eq!(s["cuts"], 0);
+        assert!(s["iterations"].as_u64().unwrap() >= 2);
+    }
+    assert!(out.join("overload/steps/0003.json").exists());
+    assert!(!out.join("overload/steps/0004.json").exists());
+}
