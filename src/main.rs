@@ -137,9 +137,20 @@ fn run_scenes(scenes: &[PathBuf], out: &Path, jobs: Option<usize>) -> Result<()>
     };
     bar.finish_and_clear();
     let mut failed = 0;
+    let mut written: Vec<(String, PathBuf)> = Vec::new();
     for (path, result) in scenes.iter().zip(results) {
         match result {
             Ok((world, summary, seconds)) => {
+                if let Some((_, first)) = written.iter().find(|(n, _)| *n == world.name) {
+                    println!(
+                        "warn  {} and {} share the name '{}': {} holds whichever finished last",
+                        first.display(),
+                        path.display(),
+                        world.name,
+                        out.join(&world.name).display()
+                    );
+                }
+                written.push((world.name.clone(), path.clone()));
                 let last = summary.steps.last();
                 println!(
                     "ok    {} -> {}: {}; {:.3} s; max |u| {:.4e} m; {} overloaded; residual {:.1e}",
@@ -150,6 +161,11 @@ fn run_scenes(scenes: &[PathBuf], out: &Path, jobs: Option<usize>) -> Result<()>
                     last.map_or(0.0, |s| s.max_displacement),
                     last.map_or(0, |s| s.overloaded),
                     summary.steps.iter().map(|s| s.residual).fold(0.0, f64::max),
+                );
+                let p = &summary.phases;
+                println!(
+                    "      phases: assembly {:.3} s, ordering+symbolic {:.3} s, factorization {:.3} s, solve {:.3} s, writing {:.3} s",
+                    p.assembly, p.symbolic, p.numeric, p.solve, p.writing
                 );
             }
             Err(e) => {
