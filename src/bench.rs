@@ -128,3 +128,98 @@ pub fn format_row(t: &LatticeTiming) -> String {
         t.peak_memory as f64 / 1048576.0
     )
 }
+
+/// One lattice solved by block-Jacobi conjugate gradients to a relative residual of 1e-10.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IterativeTiming {
+    /// Cells per direction.
+    pub cells: [usize; 3],
+    /// Members.
+    pub members: usize,
+    /// Free DOFs.
+    pub free_dofs: usize,
+    /// Pattern, fill and full-row copy, s.
+    pub assembly: Real,
+    /// Preconditioner set-up, s.
+    pub setup: Real,
+    /// Conjugate-gradient iterations.
+    pub iterations: usize,
+    /// Iteration time, s.
+    pub solve: Real,
+    /// True relative residual.
+    pub residual: Real,
+    /// Peak resident memory, bytes.
+    pub peak_memory: u64,
+}
+
+/// Assemble a lattice and solve it with block-Jacobi conjugate gradients, timing each phase.
+pub fn measure_iterative(cells: [usize; 3]) -> Result<IterativeTiming, String> {
+    use crate::linkage::{
+        axial_stiffness, conjugate_gradient, BlockJacobi, CgSettings, DofMap, StiffnessAssembly,
+        SymmetricCsr,
+    };
+    let body = lattice_body(cells)?;
+    let t = Instant::now();
+    let dofs = DofMap::new(&body);
+    let asm = StiffnessAssembly::new(&body, &dofs).map_err(|e| e.to_string())?;
+    let mut values = Vec::new();
+    asm.fill(
+        &body,
+        |m| {
+            let [a, b] = body.members[m].nodes;
+            let k = axial_stiffness(&body.materials[0], body.member_length(m));
+            crate::linkage::member_block(&body.nodes[a], &body.nodes[b], k)
+        },
+        &mut values,
+    );
+    let mut csr = SymmetricCsr::from_lower(asm.n, &asm.col_ptr, &asm.row_idx);
+    csr.refill(&values);
+    drop(values);
+    let assembly = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let m = BlockJacobi::new(&csr, &asm.groups).map_err(|e| e.to_string())?;
+    let setup = t.elapsed().as_secs_f64();
+    let d = dofs.dofs_per_node;
+    let mut b = vec![0.0; asm.n];
+    for l in &body.loads {
+        for k in 0..d {
+            if let Some(i) = dofs.free_index(l.node, k) {
+                b[i] += l.force[k];
+            }
+        }
+    }
+    let mut x = vec![0.0; asm.n];
+    let t = Instant::now();
+    let report = conjugate_gradient(&csr, &m, &b, &mut x, CgSettings::default());
+    Ok(IterativeTiming {
+        cells,
+        members: body.members.len(),
+        free_dofs: asm.n,
+        assembly,
+        setup,
+        iterations: report.iterations,
+        solve: t.elapsed().as_secs_f64(),
+        residual: report.residual,
+        peak_memory: peak_memory(),
+    })
+}
+
+/// The iterative table header.
+pub const ITERATIVE_HEADER: &str =
+    "cells         members   free DOFs  assembly     setup  iterations     solve  residual   peak MB";
+
+/// One iterative table row.
+pub fn format_iterative_row(t: &IterativeTiming) -> String {
+    format!(
+        "{:<10} {:>10} {:>11} {:>8.3}s {:>8.3}s {:>11} {:>8.3}s {:>9.1e} {:>9.0}",
+        format!("{}x{}x{}", t.cells[0], t.cells[1], t.cells[2]),
+        t.members,
+        t.free_dofs,
+        t.assembly,
+        t.setup,
+        t.iterations,
+        t.solve,
+        t.residual,
+        t.peak_memory as f64 / 1048576.0
+    )
+}

@@ -54,6 +54,9 @@ enum Command {
         /// Lattice sizes in cells, e.g. 20x20x40 (default: a series up to over 1,000,000 members).
         #[arg(long = "cells", value_parser = parse_cells)]
         cells: Vec<[usize; 3]>,
+        /// Solve with block-Jacobi conjugate gradients instead of the direct solver.
+        #[arg(long)]
+        iterative: bool,
         /// Measure in this process instead of one child process per size (then the peak
         /// memory column is the running maximum).
         #[arg(long, hide = true)]
@@ -83,7 +86,11 @@ fn main() -> ExitCode {
         Command::Run { scenes, out, jobs } => run_scenes(&scenes, &out, jobs),
         Command::Check { scenes } => check_scenes(&scenes),
         Command::Export { scene, out } => export(&scene, &out),
-        Command::Bench { cells, in_process } => bench(cells, in_process),
+        Command::Bench {
+            cells,
+            iterative,
+            in_process,
+        } => bench(cells, iterative, in_process),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -137,9 +144,20 @@ fn run_scenes(scenes: &[PathBuf], out: &Path, jobs: Option<usize>) -> Result<()>
     };
     bar.finish_and_clear();
     let mut failed = 0;
+    let mut written: Vec<(String, PathBuf)> = Vec::new();
     for (path, result) in scenes.iter().zip(results) {
         match result {
             Ok((world, summary, seconds)) => {
+                if let Some((_, first)) = written.iter().find(|(n, _)| *n == world.name) {
+                    println!(
+                        "warn  {} and {} share the name '{}': {} holds whichever finished last",
+                        first.display(),
+                        path.display(),
+                        world.name,
+                        out.join(&world.name).display()
+                    );
+                }
+                written.push((world.name.clone(), path.clone()));
                 let last = summary.steps.last();
                 println!(
                     "ok    {} -> {}: {}; {:.3} s; max |u| {:.4e} m; {} overloaded; residual {:.1e}",
@@ -150,6 +168,11 @@ fn run_scenes(scenes: &[PathBuf], out: &Path, jobs: Option<usize>) -> Result<()>
                     last.map_or(0.0, |s| s.max_displacement),
                     last.map_or(0, |s| s.overloaded),
                     summary.steps.iter().map(|s| s.residual).fold(0.0, f64::max),
+                );
+                let p = &summary.phases;
+                println!(
+                    "      phases: assembly {:.3} s, ordering+symbolic {:.3} s, factorization {:.3} s, solve {:.3} s, writing {:.3} s",
+                    p.assembly, p.symbolic, p.numeric, p.solve, p.writing
                 );
             }
             Err(e) => {
@@ -239,28 +262,40 @@ const DEFAULT_BENCH: [[usize; 3]; 6] = [
     [43, 43, 43],
 ];
 
-fn bench(cells: Vec<[usize; 3]>, in_process: bool) -> Result<()> {
+fn bench(cells: Vec<[usize; 3]>, iterative: bool, in_process: bool) -> Result<()> {
     let sizes = if cells.is_empty() {
         DEFAULT_BENCH.to_vec()
     } else {
         cells
     };
-    println!("3D box lattices: 26-neighbour cells, bottom face fixed, top face loaded; direct sparse Cholesky (METIS order)");
-    println!("{}", linkage::bench::HEADER);
+    let what = if iterative {
+        "block-Jacobi conjugate gradients to 1e-10"
+    } else {
+        "direct sparse Cholesky (METIS order)"
+    };
+    println!("3D box lattices: 26-neighbour cells, bottom face fixed, top face loaded; {what}");
+    if iterative {
+        println!("{}", linkage::bench::ITERATIVE_HEADER);
+    } else {
+        println!("{}", linkage::bench::HEADER);
+    }
     for c in sizes {
-        if in_process {
+        if in_process && iterative {
+            let t = linkage::bench::measure_iterative(c).map_err(anyhow::Error::msg)?;
+            println!("{}", linkage::bench::format_iterative_row(&t));
+        } else if in_process {
             let t = linkage::bench::measure_lattice(c).map_err(anyhow::Error::msg)?;
             println!("{}", linkage::bench::format_row(&t));
         } else {
             // One child per size, so the peak memory column is that size's own.
             let exe = std::env::current_exe().context("cannot find the linkage executable")?;
+            let mut args = vec!["bench".to_string(), "--in-process".to_string()];
+            if iterative {
+                args.push("--iterative".to_string());
+            }
+            args.extend(["--cells".to_string(), format!("{}x{}x{}", c[0], c[1], c[2])]);
             let output = std::process::Command::new(exe)
-                .args([
-                    "bench",
-                    "--in-process",
-                    "--cells",
-                    &format!("{}x{}x{}", c[0], c[1], c[2]),
-                ])
+                .args(&args)
                 .output()
                 .context("cannot start the benchmark child process")?;
             if !output.status.success() {

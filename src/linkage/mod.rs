@@ -2,11 +2,13 @@
 
 pub use self::assembly::ModelTooLarge;
 pub use self::assembly::StiffnessAssembly;
+pub use self::block_jacobi::{BlockJacobi, SingularBlock};
 pub use self::body::{
     bounding_diagonal, check_members, Body, BodyError, Dimension, Member, MemberProblem, NodalLoad,
     Schedule, Support,
 };
 pub use self::body_solver::BodySolver;
+pub use self::conjugate_gradient::{conjugate_gradient, CgReport, CgSettings};
 pub use self::dof_map::{direction_name, DofMap, DofSlot};
 pub use self::equilibrium::{Equilibrium, PhaseTimes, SolveError};
 pub use self::geometry::Geometry;
@@ -17,11 +19,14 @@ pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
 pub use self::newton::NewtonEquilibrium;
 pub use self::step_state::StepState;
+pub use self::symmetric_csr::{dot, SymmetricCsr};
 
 mod assembly;
+mod block_jacobi;
 mod body;
 mod body_solver;
 pub mod cholesky;
+mod conjugate_gradient;
 mod dof_map;
 mod equilibrium;
 pub mod generators;
@@ -36,4 +41,5 @@ mod newton;
 pub mod ordering;
 pub mod paper_files;
 mod step_state;
+mod symmetric_csr;
 mod tangent_solver;

@@ -6,6 +6,7 @@ use crate::scene::results::{BodyResult, BodySize, PhaseSeconds, StepResult, Step
 use crate::scene::World;
 use crate::Real;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// A world ready to step: each body's stiffness assembled and factored once.
@@ -126,7 +127,14 @@ pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Sum
         move |source| RunError::Write { path, source }
     };
     let final_dir = out.join(&world.name);
-    let staging = out.join(format!(".{}.partial-{}", world.name, std::process::id()));
+    // Unique per run, so two runs of one name in a batch never share a staging folder.
+    static RUNS: AtomicUsize = AtomicUsize::new(0);
+    let staging = out.join(format!(
+        ".{}.partial-{}-{}",
+        world.name,
+        std::process::id(),
+        RUNS.fetch_add(1, Ordering::Relaxed)
+    ));
     let result = (|| {
         let started = Instant::now();
         let simulation = Simulation::new(world)?;

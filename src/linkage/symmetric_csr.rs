@@ -1,0 +1,160 @@
+//! `K_ff` in full compressed rows for the iterative solver: both triangles stored, so the
+//! matrix–vector product runs row by row on every core with no write conflicts.
+
+use crate::Real;
+use rayon::prelude::*;
+
+/// Rows handed to one task in the parallel loops: large enough to amortise scheduling,
+/// small enough to balance two cores.
+const ROWS_PER_TASK: usize = 2048;
+
+/// A symmetric matrix stored in full compressed rows (both triangles), built from the
+/// lower-triangle compressed columns of [`crate::linkage::StiffnessAssembly`]. Its pattern is
+/// built once; `refill` copies new values through a stored map.
+#[derive(Clone, Debug)]
+pub struct SymmetricCsr {
+    /// Rows and columns.
+    pub n: usize,
+    /// Row starts, length `n + 1`.
+    pub row_ptr: Vec<usize>,
+    /// Column of each entry, ascending within a row.
+    pub col: Vec<u32>,
+    /// Value of each entry.
+    pub val: Vec<Real>,
+    /// For each lower-triangle entry, its places in `val` (upper place = lower place on the diagonal).
+    from_lower: Vec<[u32; 2]>,
+}
+
+impl SymmetricCsr {
+    /// The full pattern of the symmetric matrix whose lower triangle is `col_ptr`/`row_idx`
+    /// (compressed columns, diagonal present); values zero until [`SymmetricCsr::refill`].
+    pub fn from_lower(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Self {
+        let mut count = vec![0usize; n + 1];
+        for c in 0..n {
+            for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
+                count[r + 1] += 1;
+                if r != c {
+                    count[c + 1] += 1;
+                }
+            }
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let row_ptr = count.clone();
+        let nnz = row_ptr[n];
+        let mut next = count;
+        let mut col = vec![0u32; nnz];
+        let mut from_lower = vec![[0u32; 2]; row_idx.len()];
+        // Column by column, so every row receives its columns in ascending order.
+        for c in 0..n {
+            for (k, &r) in row_idx[col_ptr[c]..col_ptr[c + 1]].iter().enumerate() {
+                let e = col_ptr[c] + k;
+                let lower = next[r];
+                col[lower] = c as u32;
+                next[r] += 1;
+                let upper = if r != c {
+                    let p = next[c];
+                    col[p] = r as u32;
+                    next[c] += 1;
+                    p
+                } else {
+                    lower
+                };
+                from_lower[e] = [lower as u32, upper as u32];
+            }
+        }
+        // Row i receives its columns j < i while columns j are visited, then i and every r > i
+        // while column i is visited (rows ascending, diagonal first): sorted by construction.
+        let csr = SymmetricCsr {
+            n,
+            row_ptr,
+            col,
+            val: vec![0.0; nnz],
+            from_lower,
+        };
+        csr.check_sorted();
+        csr
+    }
+
+    fn check_sorted(&self) {
+        debug_assert!((0..self.n).all(|i| {
+            self.col[self.row_ptr[i]..self.row_ptr[i + 1]]
+                .windows(2)
+                .all(|w| w[0] < w[1])
+        }));
+    }
+
+    /// Copy the lower-triangle values (in the assembly's order) into both triangles.
+    pub fn refill(&mut self, lower_values: &[Real]) {
+        for (v, places) in lower_values.iter().zip(&self.from_lower) {
+            self.val[places[0] as usize] = *v;
+            self.val[places[1] as usize] = *v;
+        }
+    }
+
+    /// The diagonal entry of every row.
+    pub fn diagonal(&self) -> Vec<Real> {
+        (0..self.n)
+            .map(|i| {
+                let range = self.row_ptr[i]..self.row_ptr[i + 1];
+                self.col[range.clone()]
+                    .iter()
+                    .zip(&self.val[range])
+                    .find(|(c, _)| **c as usize == i)
+                    .map_or(0.0, |(_, v)| *v)
+            })
+            .collect()
+    }
+
+    /// `y = A x`, rows in parallel; each row is summed in a fixed order, so the result does
+    /// not depend on the number of threads.
+    pub fn multiply(&self, x: &[Real], y: &mut [Real]) {
+        y.par_chunks_mut(ROWS_PER_TASK)
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                let first = chunk * ROWS_PER_TASK;
+                for (k, yi) in out.iter_mut().enumerate() {
+                    let i = first + k;
+                    let range = self.row_ptr[i]..self.row_ptr[i + 1];
+                    *yi = self.col[range.clone()]
+                        .iter()
+                        .zip(&self.val[range])
+                        .map(|(&c, &v)| v * x[c as usize])
+                        .sum();
+                }
+            });
+    }
+}
+
+/// `Σ a_i b_i`, summed in fixed chunks whose partial sums are added in order: the same
+/// result whatever the number of threads.
+pub fn dot(a: &[Real], b: &[Real]) -> Real {
+    let partials: Vec<Real> = a
+        .par_chunks(ROWS_PER_TASK)
+        .zip(b.par_chunks(ROWS_PER_TASK))
+        .map(|(x, y)| x.iter().zip(y).map(|(p, q)| p * q).sum::<Real>())
+        .collect();
+    partials.iter().sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn full_rows_match_the_lower_triangle() {
+        // Lower triangle of [[4, 1, 0], [1, 5, 2], [0, 2, 6]] in compressed columns.
+        let col_ptr = [0, 2, 4, 5];
+        let row_idx = [0, 1, 1, 2, 2];
+        let mut a = SymmetricCsr::from_lower(3, &col_ptr, &row_idx);
+        a.refill(&[4.0, 1.0, 5.0, 2.0, 6.0]);
+        assert_eq!(a.row_ptr, vec![0, 2, 5, 7]);
+        assert_eq!(a.col, vec![0, 1, 0, 1, 2, 1, 2]);
+        assert_eq!(a.diagonal(), vec![4.0, 5.0, 6.0]);
+        let mut y = vec![0.0; 3];
+        a.multiply(&[1.0, 2.0, 3.0], &mut y);
+        assert_eq!(y, vec![6.0, 17.0, 22.0]);
+        assert_eq!(dot(&[1.0, 2.0, 3.0], &[4.0, 5.0, 6.0]), 32.0);
+    }
+}
