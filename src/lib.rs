@@ -33,5 +33,6 @@ pub type Real = f64;
 
 pub mod atomic_file;
 pub mod bench;
+pub mod bench_large;
 pub mod linkage;
 pub mod scene;
