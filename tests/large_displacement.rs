@@ -436,3 +436,62 @@ force = [0.0, -9000.0]   # 1.18 times the limit load (7622 N)
     assert!(out.join("overload/steps/0003.json").exists());
     assert!(!out.join("overload/steps/0004.json").exists());
 }
+
+/// A strut (compression-only) pulled carries nothing; pushed, it carries the load.
+#[test]
+fn compression_only_strut_carries_no_tension() {
+    for (push, expect) in [(-800.0, -800.0), (800.0, 0.0)] {
+        let mut body = Body::new("strut", Dimension::Two);
+        body.materials.push(Material::new("steel", 200e9, 1e-4));
+        let mut strut = Material::new("strut", 200e9, 1e-4);
+        strut.behaviour = Behaviour::CompressionOnly;
+        body.materials.push(strut);
+        // Node 2 held by a strut to node 1 and a steel bar to node 3, loaded along x.
+        body.nodes = vec![v(0.0, 0.0), v(1.0, 0.0), v(2.0, 0.0)];
+        bar(&mut body, 0, 1, 1);
+        bar(&mut body, 1, 2, 0);
+        body.supports.push(Support::fixed(0, [true, true, false]));
+        body.supports.push(Support::fixed(1, [false, true, false]));
+        body.supports.push(Support::fixed(2, [true, true, false]));
+        // A push toward node 1 (−x) compresses the strut and stretches the bar equally.
+        body.loads.push(load(1, v(2.0 * push, 0.0)));
+        body.kinematics = Kinematics::Large;
+        let s = solve_all(&body, 1).pop().unwrap();
+        assert!(
+            (s.axial_forces[0] - expect).abs() <= 1e-4 * 800.0,
+            "{push}: {:?}",
+            s.axial_forces
+        );
+        if expect == 0.0 {
+            assert_eq!(s.axial_forces[0], 0.0);
+        }
+    }
+}
+
+/// The bundled snap-through scene through the scene driver: λ is reported as the step's
+/// load factor, it turns negative on the falling branch, and the summary marks exactly the
+/// steps between the limit points as unstable (one negative pivot).
+#[test]
+fn bundled_von_mises_scene_reports_load_factor_and_stability() {
+    let world =
+        linkage::scene::load_scene(std::path::Path::new("scenes/von_mises_truss.toml")).unwrap();
+    let sim = linkage::scene::Simulation::new(&world).unwrap();
+    let (w_limit, _) = von_mises_limit();
+    let mut unstable = 0;
+    for step in 0..=world.steps {
+        let (result, summary) = sim.step(step).unwrap();
+        assert_eq!(result.load_factor, summary.load_factor);
+        let w = -result.bodies[0].displacements[1][1];
+        // Between the limit points w_limit and 2h − w_limit (by symmetry of P about w = h).
+        let inside = w > w_limit + 1e-3 && w < 2.0 * H - w_limit - 1e-3;
+        let outside = w < w_limit - 1e-3 || w > 2.0 * H - w_limit + 1e-3;
+        if inside {
+            assert_eq!(summary.negative_pivots, 1, "step {step}: w = {w}");
+            unstable += 1;
+        } else if outside {
+            assert_eq!(summary.negative_pivots, 0, "step {step}: w = {w}");
+        }
+        assert_eq!(summary.cuts, 0);
+    }
+    assert!(unstable > 10);
+}

@@ -1,4 +1,5 @@
-//! One body: its nodes, members, patches, supports and loads, and the linear solve of the paper.
+//! One body: its nodes, members, patches, supports and loads; the linear solve of the paper and
+//! the Newton solve for large displacements, cables and struts.
 
 pub use self::assembly::ModelTooLarge;
 pub use self::assembly::StiffnessAssembly;

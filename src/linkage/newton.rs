@@ -25,6 +25,29 @@ struct IncrementFailure {
 
 /// The nonlinear equilibrium of one body, advanced step by step. Holds the current
 /// displacement field between steps.
+///
+/// ```
+/// use linkage::linkage::{Body, Dimension, Kinematics, Material, Member, NewtonEquilibrium, Schedule, Support};
+/// use nalgebra::Vector3;
+///
+/// // A bar 1 m long along x pulled to twice its length by its end support.
+/// let mut body = Body::new("bar", Dimension::Two);
+/// body.materials.push(Material::new("rubber", 1e7, 1e-4));
+/// body.nodes = vec![Vector3::zeros(), Vector3::new(1.0, 0.0, 0.0)];
+/// body.members.push(Member { nodes: [0, 1], material: 0 });
+/// body.supports.push(Support::fixed(0, [true, true, false]));
+/// body.supports.push(Support {
+///     node: 1,
+///     fixed: [true, true, false],
+///     displacement: Vector3::new(1.0, 0.0, 0.0),
+///     schedule: Schedule::Linear,
+/// });
+/// body.kinematics = Kinematics::Large;
+/// let mut newton = NewtonEquilibrium::new(&body).unwrap();
+/// let state = newton.solve_step(&body, 1, 1).unwrap();
+/// // Engineering strain (2L − L)/L = 1, so N = E A.
+/// assert!((state.axial_forces[0] - 1e7 * 1e-4).abs() < 1e-9);
+/// ```
 pub struct NewtonEquilibrium {
     /// The free/support partition.
     pub dofs: DofMap,
@@ -131,6 +154,7 @@ impl NewtonEquilibrium {
             self.previous.iter_mut().for_each(|v| *v = 0.0);
             self.lambda = 0.0;
             self.step = 0;
+            self.negative_pivots = 0;
         }
         let mut iterations = 0;
         let mut cuts = 0;
@@ -154,6 +178,7 @@ impl NewtonEquilibrium {
                 .displacements
                 .iter()
                 .any(|u| !u.iter().all(|c| c.is_finite()))
+            || !state.axial_forces.iter().all(|n| n.is_finite())
         {
             return Err(SolveError::Inaccurate {
                 body: body.name.clone(),
@@ -284,16 +309,11 @@ impl NewtonEquilibrium {
         self.times.solve += t.elapsed().as_secs_f64();
     }
 
-    /// Internal forces and the free out-of-balance `F − f_int` at `u`, timed as assembly.
-    fn out_of_balance(
-        &mut self,
-        body: &Body,
-        u: &[Real],
-        forces: &[Real],
-        internal: &mut [Real],
-    ) -> Vec<Real> {
+    /// Internal forces and the free out-of-balance `F − f_int` at the current displacement
+    /// (timed as assembly).
+    fn out_of_balance(&mut self, body: &Body, forces: &[Real], internal: &mut [Real]) -> Vec<Real> {
         let t = Instant::now();
-        internal_forces(body, self.dofs.dofs_per_node, u, internal);
+        internal_forces(body, self.dofs.dofs_per_node, &self.u, internal);
         self.times.assembly += t.elapsed().as_secs_f64();
         self.dofs
             .free
@@ -361,7 +381,7 @@ impl NewtonEquilibrium {
         };
         // Predictor: K_ff Δu_f = F_f − f_int,f − K_fs Δu_s.
         let mut internal = vec![0.0; nd];
-        let mut rhs = self.out_of_balance(body, &self.u.clone(), &forces, &mut internal);
+        let mut rhs = self.out_of_balance(body, &forces, &mut internal);
         self.refactor(body).map_err(|r| fail(r, &history))?;
         let mut du_s = vec![0.0; nd];
         let mut moved = false;
@@ -386,7 +406,7 @@ impl NewtonEquilibrium {
         let mut last_step = norm(&rhs);
         let mut iterations = 1;
         loop {
-            let r = self.out_of_balance(body, &self.u.clone(), &forces, &mut internal);
+            let r = self.out_of_balance(body, &forces, &mut internal);
             let scale = force_scale(&self.dofs, &forces, &internal);
             let rnorm = norm(&r);
             let relative = if scale > 0.0 {
@@ -443,17 +463,13 @@ impl NewtonEquilibrium {
         r0: Real,
         internal: &mut [Real],
     ) -> Real {
-        let base = self.u.clone();
-        let mut trial = base.clone();
+        let base: Vec<Real> = self.dofs.free.iter().map(|&dof| self.u[dof]).collect();
         let mut best = (Real::INFINITY, 1.0);
         let mut s = 1.0;
         for _ in 0..5 {
-            for (i, &dof) in self.dofs.free.iter().enumerate() {
-                trial[dof] = base[dof] + s * delta[i];
-            }
-            let r = norm(&self.out_of_balance(body, &trial, forces, internal));
+            self.move_free(&base, delta, s);
+            let r = norm(&self.out_of_balance(body, forces, internal));
             if r.is_finite() && r <= (1.0 - 1e-4 * s) * r0 {
-                self.u = trial;
                 return s * norm(delta);
             }
             if r < best.0 {
@@ -464,10 +480,15 @@ impl NewtonEquilibrium {
         // No step lowered the residual: take the best (or the full step if all diverged); the
         // iteration limit decides.
         let s = if best.0.is_finite() { best.1 } else { 1.0 };
-        for (i, &dof) in self.dofs.free.iter().enumerate() {
-            self.u[dof] = base[dof] + s * delta[i];
-        }
+        self.move_free(&base, delta, s);
         s * norm(delta)
+    }
+
+    /// Free displacements `base + s δ` (both per free DOF).
+    fn move_free(&mut self, base: &[Real], delta: &[Real], s: Real) {
+        for (i, &dof) in self.dofs.free.iter().enumerate() {
+            self.u[dof] = base[i] + s * delta[i];
+        }
     }
 
     /// Arc length: advance one step of `length` along the path, in sub-increments that are
@@ -554,7 +575,7 @@ impl NewtonEquilibrium {
         let mut internal = vec![0.0; nd];
         loop {
             let forces: Vec<Real> = reference.iter().map(|f| f * self.lambda).collect();
-            let r = self.out_of_balance(body, &self.u.clone(), &forces, &mut internal);
+            let r = self.out_of_balance(body, &forces, &mut internal);
             let scale = force_scale(&self.dofs, &forces, &internal).max(ref_norm);
             let relative = norm(&r) / scale;
             history.push(relative);

@@ -32,7 +32,10 @@ pub struct StepState {
     /// The load factor the step reached when the path decides it (arc length); `None` when the
     /// schedules decide it.
     pub load_factor: Option<Real>,
-    /// Negative pivots of the tangent stiffness at the solution (0: stable; large kinematics only).
+    /// Negative pivots of the tangent stiffness at the solution (0: stable; k: unstable in k
+    /// directions). Counted by the LDLᵀ factorization of the last Newton iteration, whose
+    /// iterate differs from the solution by less than the displacement tolerance; always 0 for
+    /// a linear body.
     pub negative_pivots: usize,
 }
 

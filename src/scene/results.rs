@@ -75,6 +75,10 @@ pub struct StepSummary {
     pub iterations: usize,
     /// Halvings of the load increment Newton needed (all bodies; 0 for a linear step).
     pub cuts: usize,
+    /// Negative pivots of the tangent stiffness at the step's solution, summed over the
+    /// bodies: 0 for a stable equilibrium (and for every linear step), k > 0 when the
+    /// equilibrium is unstable in k directions (past a limit point, on a falling branch).
+    pub negative_pivots: usize,
     /// Contact iterations (0 without contact).
     pub contact_iterations: usize,
     /// Relative out-of-balance force, largest over the bodies.

@@ -66,6 +66,7 @@ impl<'w> Simulation<'w> {
             load_factor: result.load_factor,
             iterations: 0,
             cuts: 0,
+            negative_pivots: 0,
             contact_iterations: 0,
             residual: 0.0,
             max_displacement: 0.0,
@@ -83,6 +84,7 @@ impl<'w> Simulation<'w> {
             summary.residual = summary.residual.max(state.residual);
             summary.iterations = summary.iterations.max(state.iterations);
             summary.cuts += state.cuts;
+            summary.negative_pivots += state.negative_pivots;
             if let Some(lambda) = state.load_factor {
                 // The path (arc length) decided this body's load factor.
                 result.load_factor = lambda;
