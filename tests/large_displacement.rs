@@ -495,3 +495,55 @@ fn bundled_von_mises_scene_reports_load_factor_and_stability() {
     }
     assert!(unstable > 10);
 }
+
+/// New scene keys are checked like the others: the message names the file, the line or the
+/// body, and what to write instead.
+#[test]
+fn bad_nonlinear_settings_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let here = std::env::current_dir().unwrap().join("scenes");
+    let scene = |body_extra: &str, material_extra: &str| {
+        let text = format!(
+            "name = \"t\"\n[[materials]]\nname = \"steel\"\nyoungs_modulus = 200e9\narea = 1e-4\n{material_extra}\n\
+             [[bodies]]\nname = \"truss\"\nnodes = \"{}\"\nlinks = \"{}\"\n{body_extra}\n\
+             [[bodies.supports]]\nnodes = [1, 3]\nfix = [\"x\", \"y\"]\n\
+             [[bodies.loads]]\nnodes = [2]\nforce = [0.0, -1000.0]\n",
+            here.join("von_mises.nodes").display(),
+            here.join("von_mises.links").display()
+        );
+        let p = dir.path().join("scene.toml");
+        std::fs::write(&p, text).unwrap();
+        match linkage::scene::load_scene(&p) {
+            Err(e) => e.to_string(),
+            Ok(_) => "ok".to_string(),
+        }
+    };
+    let e = scene("kinematics = \"huge\"", "");
+    assert!(
+        e.contains("scene.toml:") && e.contains("\"linear\"") && e.contains("\"large\""),
+        "{e}"
+    );
+    let e = scene("", "behaviour = \"rope\"");
+    assert!(
+        e.contains("tension_only") && e.contains("compression_only"),
+        "{e}"
+    );
+    let e = scene(
+        "kinematics = \"large\"\n[bodies.path]\nmethod = \"arc_length\"",
+        "",
+    );
+    assert!(e.contains("needs `arc_length`"), "{e}");
+    let e = scene("[bodies.path]\nmethod = \"riks\"", "");
+    assert!(
+        e.contains("\"schedules\"") && e.contains("\"arc_length\""),
+        "{e}"
+    );
+    let e = scene("[bodies.newton]\ntolerance = 0.0", "");
+    assert!(e.contains("body 'truss'") && e.contains("tolerance"), "{e}");
+    let e = scene("[bodies.newton]\nmax_iteration = 3", "");
+    assert!(e.contains("unknown field"), "{e}");
+    assert_eq!(
+        scene("kinematics = \"large\"\n[bodies.newton]\nmax_cuts = 4", ""),
+        "ok"
+    );
+}

@@ -173,6 +173,9 @@ impl NewtonEquilibrium {
         let mut state = self.state(body, steps);
         state.iterations = iterations;
         state.cuts = cuts;
+        if step > 0 {
+            state.residual_history = self.residual_history.clone();
+        }
         if !state.residual.is_finite()
             || state
                 .displacements

@@ -29,6 +29,9 @@ pub struct StepState {
     pub iterations: usize,
     /// How many times the step's load increment was halved because Newton did not converge.
     pub cuts: usize,
+    /// Relative residual after each Newton iteration of the step's last increment (empty for a
+    /// linear step): shows the convergence rate.
+    pub residual_history: Vec<Real>,
     /// The load factor the step reached when the path decides it (arc length); `None` when the
     /// schedules decide it.
     pub load_factor: Option<Real>,

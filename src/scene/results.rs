@@ -75,6 +75,10 @@ pub struct StepSummary {
     pub iterations: usize,
     /// Halvings of the load increment Newton needed (all bodies; 0 for a linear step).
     pub cuts: usize,
+    /// Relative residual after each Newton iteration of the step's last increment, for the
+    /// body that needed the most iterations (absent for linear steps).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub residuals: Vec<Real>,
     /// Negative pivots of the tangent stiffness at the step's solution, summed over the
     /// bodies: 0 for a stable equilibrium (and for every linear step), k > 0 when the
     /// equilibrium is unstable in k directions (past a limit point, on a falling branch).

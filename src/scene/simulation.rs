@@ -67,6 +67,7 @@ impl<'w> Simulation<'w> {
             iterations: 0,
             cuts: 0,
             negative_pivots: 0,
+            residuals: Vec::new(),
             contact_iterations: 0,
             residual: 0.0,
             max_displacement: 0.0,
@@ -82,6 +83,9 @@ impl<'w> Simulation<'w> {
                         source,
                     })?;
             summary.residual = summary.residual.max(state.residual);
+            if state.iterations > summary.iterations {
+                summary.residuals = state.residual_history.clone();
+            }
             summary.iterations = summary.iterations.max(state.iterations);
             summary.cuts += state.cuts;
             summary.negative_pivots += state.negative_pivots;
