@@ -42,14 +42,17 @@ pub enum SolveError {
         /// What faer reported.
         message: String,
     },
-    /// A nonlinear step did not converge even after halving its increment `cuts` times.
-    #[error("body '{body}': step {step} did not converge after {cuts} halvings of its load increment: {reason}; relative residuals of the last attempt: [{}]. Use more steps (smaller increments), raise [bodies.newton] max_cuts or max_iterations, or follow a limit point with [bodies.path] method = \"arc_length\"", format_history(.history))]
+    /// A nonlinear step did not converge even with its increment halved `depth` (= the
+    /// body's `max_cuts`) times.
+    #[error("body '{body}': step {step} did not converge, even with its load increment halved {depth} times (to 1/{} of the step; {cuts} halvings in this step): {reason}; relative residuals of the last attempt: [{}]. Use more steps (smaller increments), raise [bodies.newton] max_cuts or max_iterations, or follow a limit point with [bodies.path] method = \"arc_length\"", 1u64 << (*.depth).min(63), format_history(.history))]
     NotConverged {
         /// Body name.
         body: String,
         /// The step (1-based) that failed.
         step: usize,
-        /// Halvings tried.
+        /// Halvings of the increment in force when it failed.
+        depth: usize,
+        /// Halvings in this step in all.
         cuts: usize,
         /// Why the last attempt failed.
         reason: String,

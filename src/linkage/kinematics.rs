@@ -44,7 +44,8 @@ pub struct NewtonSettings {
     pub displacement_tolerance: Real,
     /// Newton iterations allowed per load increment before the increment is halved.
     pub max_iterations: usize,
-    /// Halvings allowed per step before the run stops with an error.
+    /// The smallest increment is `1/2^max_cuts` of a step (of the arc length): when it fails,
+    /// the run stops with an error.
     pub max_cuts: usize,
     /// How the load path is followed.
     pub path: PathMethod,

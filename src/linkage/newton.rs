@@ -335,9 +335,10 @@ impl NewtonEquilibrium {
     ) -> Result<(usize, usize), SolveError> {
         let end = target as Real;
         let mut t = (target - 1) as Real;
-        let mut dt = 1.0;
-        let (mut iterations, mut cuts) = (0, 0);
+        let mut size = IncrementSize::default();
+        let mut iterations = 0;
         while t < end {
+            let dt = size.fraction();
             let t1 = if end - t <= dt * (1.0 + 1e-12) {
                 end
             } else {
@@ -348,20 +349,18 @@ impl NewtonEquilibrium {
                 Ok(n) => {
                     iterations += n;
                     t = t1;
-                    dt = (dt * 2.0).min(1.0);
+                    size.succeeded();
                 }
                 Err(failure) => {
                     iterations += failure.history.len();
                     self.u = saved;
-                    cuts += 1;
-                    if cuts > body.newton.max_cuts {
-                        return Err(not_converged(body, target, cuts - 1, failure));
+                    if !size.failed(body.newton.max_cuts) {
+                        return Err(not_converged(body, target, &size, failure));
                     }
-                    dt *= 0.5;
                 }
             }
         }
-        Ok((iterations, cuts))
+        Ok((iterations, size.cuts))
     }
 
     /// One load-control increment from the current state to pseudo-time `t1`: a tangent
@@ -503,29 +502,27 @@ impl NewtonEquilibrium {
         length: Real,
     ) -> Result<(usize, usize), SolveError> {
         let mut covered = 0.0;
-        let mut dl = length;
-        let (mut iterations, mut cuts) = (0, 0);
+        let mut size = IncrementSize::default();
+        let mut iterations = 0;
         while covered < length * (1.0 - 1e-12) {
-            let arc = dl.min(length - covered);
+            let arc = (length * size.fraction()).min(length - covered);
             let (u0, l0, p0) = (self.u.clone(), self.lambda, self.previous.clone());
             match self.arc_increment(body, arc) {
                 Ok(n) => {
                     iterations += n;
                     covered += arc;
-                    dl = (dl * 2.0).min(length);
+                    size.succeeded();
                 }
                 Err(failure) => {
                     iterations += failure.history.len();
                     (self.u, self.lambda, self.previous) = (u0, l0, p0);
-                    cuts += 1;
-                    if cuts > body.newton.max_cuts {
-                        return Err(not_converged(body, target, cuts - 1, failure));
+                    if !size.failed(body.newton.max_cuts) {
+                        return Err(not_converged(body, target, &size, failure));
                     }
-                    dl *= 0.5;
                 }
             }
         }
-        Ok((iterations, cuts))
+        Ok((iterations, size.cuts))
     }
 
     /// One increment of Crisfield's cylindrical arc-length method: `|Δu_f| = arc`, with the
@@ -643,12 +640,54 @@ impl NewtonEquilibrium {
     }
 }
 
+/// The size of the next increment within a step, as the fraction `2^-depth` of the step:
+/// halved after an increment fails, doubled again after two successes in a row (so a hard
+/// stretch of the path is crossed in small increments, and the rest of the step is not).
+#[derive(Clone, Copy, Debug, Default)]
+struct IncrementSize {
+    depth: usize,
+    streak: usize,
+    /// Halvings so far in this step.
+    cuts: usize,
+}
+
+impl IncrementSize {
+    fn fraction(&self) -> Real {
+        0.5f64.powi(self.depth.min(1000) as i32)
+    }
+
+    fn succeeded(&mut self) {
+        self.streak += 1;
+        if self.streak >= 2 && self.depth > 0 {
+            self.depth -= 1;
+            self.streak = 0;
+        }
+    }
+
+    /// Halve; false when that would go below `2^-max_cuts` of a step.
+    fn failed(&mut self, max_cuts: usize) -> bool {
+        self.streak = 0;
+        if self.depth >= max_cuts {
+            return false;
+        }
+        self.depth += 1;
+        self.cuts += 1;
+        true
+    }
+}
+
 /// The error for a step that could not be solved even with the smallest increment.
-fn not_converged(body: &Body, step: usize, cuts: usize, failure: IncrementFailure) -> SolveError {
+fn not_converged(
+    body: &Body,
+    step: usize,
+    size: &IncrementSize,
+    failure: IncrementFailure,
+) -> SolveError {
     SolveError::NotConverged {
         body: body.name.clone(),
         step,
-        cuts,
+        depth: size.depth,
+        cuts: size.cuts,
         reason: failure.reason,
         history: failure.history,
     }

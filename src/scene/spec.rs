@@ -96,7 +96,7 @@ pub struct NewtonSpec {
     pub displacement_tolerance: Option<Real>,
     /// Newton iterations per increment before it is halved (default 30).
     pub max_iterations: Option<usize>,
-    /// Halvings of the increment allowed per step (default 10).
+    /// Smallest increment `1/2^max_cuts` of a step (default 10).
     pub max_cuts: Option<usize>,
 }
 
