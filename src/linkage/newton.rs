@@ -72,6 +72,11 @@ pub struct NewtonEquilibrium {
     previous: Vec<Real>,
     /// Negative pivots of the last factored tangent.
     negative_pivots: usize,
+    /// The largest force scale (applied or reaction norm, N) and displacement norm (m) of the
+    /// states converged so far: floors of what "relative" refers to, so that unloading back to
+    /// zero (where both vanish) still converges.
+    force_floor: Real,
+    displacement_floor: Real,
 }
 
 impl NewtonEquilibrium {
@@ -96,6 +101,8 @@ impl NewtonEquilibrium {
             lambda: 0.0,
             step: 0,
             negative_pivots: 0,
+            force_floor: 0.0,
+            displacement_floor: 0.0,
         };
         eq.fill_tangent(body);
         eq.times.assembly += t.elapsed().as_secs_f64();
@@ -155,6 +162,8 @@ impl NewtonEquilibrium {
             self.lambda = 0.0;
             self.step = 0;
             self.negative_pivots = 0;
+            self.force_floor = 0.0;
+            self.displacement_floor = 0.0;
         }
         let mut iterations = 0;
         let mut cuts = 0;
@@ -203,13 +212,19 @@ impl NewtonEquilibrium {
             (r.strain, r.force)
         });
         let mut state = post_process(body, &self.dofs, &self.u, &forces, &internal, members);
+        let mut scale = force_scale(&self.dofs, &forces, &internal).max(self.force_floor);
         if let PathMethod::ArcLength { .. } = body.newton.path {
             state.load_factor = Some(self.lambda);
-            let scale =
-                force_scale(&self.dofs, &forces, &internal).max(norm(&self.reference(body)));
-            state.residual =
-                free_norm(&self.dofs, &forces, &internal) / scale.max(Real::MIN_POSITIVE);
+            scale = scale.max(norm(&self.reference(body)));
         }
+        let out_of_balance = free_norm(&self.dofs, &forces, &internal);
+        state.residual = if scale > 0.0 {
+            out_of_balance / scale
+        } else if out_of_balance > 0.0 {
+            Real::INFINITY
+        } else {
+            0.0
+        };
         state.negative_pivots = self.negative_pivots;
         state
     }
@@ -409,7 +424,7 @@ impl NewtonEquilibrium {
         let mut iterations = 1;
         loop {
             let r = self.out_of_balance(body, &forces, &mut internal);
-            let scale = force_scale(&self.dofs, &forces, &internal);
+            let scale = force_scale(&self.dofs, &forces, &internal).max(self.force_floor);
             let rnorm = norm(&r);
             let relative = if scale > 0.0 {
                 rnorm / scale
@@ -426,14 +441,16 @@ impl NewtonEquilibrium {
                     &history,
                 ));
             }
+            let u_norm = norm(&self.u).max(self.displacement_floor);
             if relative <= settings.tolerance
-                && last_step
-                    <= settings.displacement_tolerance * norm(&self.u).max(Real::MIN_POSITIVE)
+                && last_step <= settings.displacement_tolerance * u_norm.max(Real::MIN_POSITIVE)
             {
+                self.converged(scale, u_norm);
                 self.residual_history = history;
                 return Ok(iterations);
             }
             if relative <= settings.tolerance && rnorm == 0.0 {
+                self.converged(scale, u_norm);
                 self.residual_history = history;
                 return Ok(iterations);
             }
@@ -484,6 +501,13 @@ impl NewtonEquilibrium {
         let s = if best.0.is_finite() { best.1 } else { 1.0 };
         self.move_free(&base, delta, s);
         s * norm(delta)
+    }
+
+    /// Raise the floors of the relative tests to a converged state's force scale (N) and
+    /// displacement norm (m).
+    fn converged(&mut self, force_scale: Real, displacement_norm: Real) {
+        self.force_floor = self.force_floor.max(force_scale);
+        self.displacement_floor = self.displacement_floor.max(displacement_norm);
     }
 
     /// Free displacements `base + s δ` (both per free DOF).
@@ -576,15 +600,19 @@ impl NewtonEquilibrium {
         loop {
             let forces: Vec<Real> = reference.iter().map(|f| f * self.lambda).collect();
             let r = self.out_of_balance(body, &forces, &mut internal);
-            let scale = force_scale(&self.dofs, &forces, &internal).max(ref_norm);
+            let scale = force_scale(&self.dofs, &forces, &internal)
+                .max(ref_norm)
+                .max(self.force_floor);
             let relative = norm(&r) / scale;
             history.push(relative);
             if !relative.is_finite() {
                 return Err(fail("the residual is not finite".to_string(), &history));
             }
+            let u_norm = norm(&self.u).max(self.displacement_floor);
             if relative <= settings.tolerance
-                && last_step <= settings.displacement_tolerance * norm(&self.u).max(arc)
+                && last_step <= settings.displacement_tolerance * u_norm.max(arc)
             {
+                self.converged(scale, u_norm);
                 self.previous = du;
                 self.residual_history = history;
                 return Ok(iterations);
