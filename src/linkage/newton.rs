@@ -265,17 +265,32 @@ impl NewtonEquilibrium {
 
     /// Prescribed displacement per body DOF at pseudo-time `t`, m (zero at free DOFs).
     fn prescribed_at(&self, body: &Body, t: Real, steps: usize) -> Vec<Real> {
+        // Grouped by schedule as the linear solve does (`Equilibrium`): within one schedule a
+        // later support's value of a DOF replaces an earlier one's, different schedules add up.
         let d = self.dofs.dofs_per_node;
-        let mut u = vec![0.0; body.dof_count()];
+        let mut patterns: Vec<(&Schedule, Vec<Real>)> = Vec::new();
         for s in &body.supports {
             if s.displacement == Vector3::zeros() {
                 continue;
             }
-            let factor = factor_at(&s.schedule, t, steps);
+            let p = match patterns.iter().position(|(sched, _)| *sched == &s.schedule) {
+                Some(p) => p,
+                None => {
+                    patterns.push((&s.schedule, vec![0.0; body.dof_count()]));
+                    patterns.len() - 1
+                }
+            };
             for k in 0..d {
                 if s.fixed[k] {
-                    u[s.node * d + k] += factor * s.displacement[k];
+                    patterns[p].1[s.node * d + k] = s.displacement[k];
                 }
+            }
+        }
+        let mut u = vec![0.0; body.dof_count()];
+        for (schedule, values) in patterns {
+            let factor = factor_at(schedule, t, steps);
+            for (a, b) in u.iter_mut().zip(values) {
+                *a += factor * b;
             }
         }
         u
