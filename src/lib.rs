@@ -26,6 +26,11 @@
 //! assert!((state.displacements[1].x - 1000.0 / (1e-4 * 200e9)).abs() < 1e-15);
 //! ```
 //!
+//! Large displacements (members whose force follows their current length and acts along their
+//! current direction), cables and struts are solved step by step by Newton–Raphson in
+//! [`linkage::NewtonEquilibrium`] (with an arc-length path for snap-through);
+//! [`linkage::BodySolver`] picks the solver a body needs.
+//!
 //! The scene files, the load-step driver and the result files live in [`scene`].
 
 /// The one scalar type: SI units throughout (m, N, Pa, m²).
