@@ -54,9 +54,13 @@ enum Command {
         /// Lattice sizes in cells, e.g. 20x20x40 (default: a series up to over 1,000,000 members).
         #[arg(long = "cells", value_parser = parse_cells)]
         cells: Vec<[usize; 3]>,
-        /// Solve with block-Jacobi conjugate gradients instead of the direct solver.
+        /// Solve with conjugate gradients and smoothed-aggregation multigrid instead of the
+        /// direct solver.
         #[arg(long)]
         iterative: bool,
+        /// With --iterative: precondition with block Jacobi instead of multigrid.
+        #[arg(long, requires = "iterative")]
+        jacobi: bool,
         /// Measure in this process instead of one child process per size (then the peak
         /// memory column is the running maximum).
         #[arg(long, hide = true)]
@@ -89,8 +93,9 @@ fn main() -> ExitCode {
         Command::Bench {
             cells,
             iterative,
+            jacobi,
             in_process,
-        } => bench(cells, iterative, in_process),
+        } => bench(cells, iterative, jacobi, in_process),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -262,14 +267,16 @@ const DEFAULT_BENCH: [[usize; 3]; 6] = [
     [43, 43, 43],
 ];
 
-fn bench(cells: Vec<[usize; 3]>, iterative: bool, in_process: bool) -> Result<()> {
+fn bench(cells: Vec<[usize; 3]>, iterative: bool, jacobi: bool, in_process: bool) -> Result<()> {
     let sizes = if cells.is_empty() {
         DEFAULT_BENCH.to_vec()
     } else {
         cells
     };
-    let what = if iterative {
+    let what = if iterative && jacobi {
         "block-Jacobi conjugate gradients to 1e-10"
+    } else if iterative {
+        "smoothed-aggregation multigrid conjugate gradients to 1e-10"
     } else {
         "direct sparse Cholesky (METIS order)"
     };
@@ -281,7 +288,7 @@ fn bench(cells: Vec<[usize; 3]>, iterative: bool, in_process: bool) -> Result<()
     }
     for c in sizes {
         if in_process && iterative {
-            let t = linkage::bench::measure_iterative(c).map_err(anyhow::Error::msg)?;
+            let t = linkage::bench::measure_iterative(c, !jacobi).map_err(anyhow::Error::msg)?;
             println!("{}", linkage::bench::format_iterative_row(&t));
         } else if in_process {
             let t = linkage::bench::measure_lattice(c).map_err(anyhow::Error::msg)?;
@@ -292,6 +299,9 @@ fn bench(cells: Vec<[usize; 3]>, iterative: bool, in_process: bool) -> Result<()
             let mut args = vec!["bench".to_string(), "--in-process".to_string()];
             if iterative {
                 args.push("--iterative".to_string());
+            }
+            if jacobi {
+                args.push("--jacobi".to_string());
             }
             args.extend(["--cells".to_string(), format!("{}x{}x{}", c[0], c[1], c[2])]);
             let output = std::process::Command::new(exe)

@@ -14,7 +14,8 @@ pub use self::geometry::Geometry;
 pub use self::material::Material;
 pub use self::mechanism::Mechanism;
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
-pub use self::symmetric_csr::{dot, SymmetricCsr};
+pub use self::smoothed_aggregation::{MultigridError, SmoothedAggregation};
+pub use self::symmetric_csr::{dot, Preconditioner, SymmetricCsr};
 
 mod assembly;
 mod block_jacobi;
@@ -30,4 +31,5 @@ mod mechanism;
 mod member_stiffness;
 pub mod ordering;
 pub mod paper_files;
+mod smoothed_aggregation;
 mod symmetric_csr;
