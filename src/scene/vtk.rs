@@ -241,11 +241,13 @@ fn overloaded_flags(m: &ModelBody, r: &BodyResult) -> Vec<u8> {
     f
 }
 
+/// Scalars (1 component) leave `NumberOfComponents` out, so readers give plain arrays.
 fn array_open(s: &mut String, ty: &str, name: &str, components: usize) {
-    let _ = write!(
-        s,
-        "        <DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{components}\" format=\"ascii\">\n          "
-    );
+    let _ = write!(s, "        <DataArray type=\"{ty}\" Name=\"{name}\" ");
+    if components > 1 {
+        let _ = write!(s, "NumberOfComponents=\"{components}\" ");
+    }
+    s.push_str("format=\"ascii\">\n          ");
 }
 
 fn vectors(s: &mut String, name: &str, v: &[[Real; 3]]) {
