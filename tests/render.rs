@@ -368,3 +368,53 @@ fn rendering_a_missing_or_torn_folder_says_what_to_do() {
     .to_string();
     assert!(err.contains("width 3"), "{err}");
 }
+
+#[test]
+fn contact_forces_are_drawn_as_orange_arrows_when_present() {
+    let (model, mut step) = square();
+    let count_orange = |frame: &Frame| {
+        let mut n = 0;
+        for y in 0..frame.height() {
+            for x in 0..frame.width() {
+                let c = frame.rgb(x, y).unwrap();
+                if c.0 > 0.8 && (0.35..0.6).contains(&c.1) && c.2 < 0.15 {
+                    n += 1;
+                }
+            }
+        }
+        n
+    };
+    let ext = extent(&model, &step, Some(1.0));
+    let without = count_orange(&draw_frame(&model, &step, &ext, &options()).unwrap());
+    step.bodies[0].contacts.push(linkage::scene::ContactForce {
+        node: 2,
+        with: "floor".into(),
+        depth: 1e-4,
+        force: vec![0.0, 300.0],
+    });
+    let ext = extent(&model, &step, Some(1.0));
+    let with = count_orange(&draw_frame(&model, &step, &ext, &options()).unwrap());
+    assert_eq!(without, 0);
+    assert!(with > 10, "{with} orange pixels");
+}
+
+#[test]
+fn a_3d_body_without_patches_is_drawn_as_coloured_lines() {
+    let (mut model, mut step) = square();
+    let b = &mut model.bodies[0];
+    b.dimension = 3;
+    for p in &mut b.nodes {
+        p.push(0.0);
+    }
+    b.nodes[3][2] = 0.5;
+    let r = &mut step.bodies[0];
+    r.positions = b.nodes.clone();
+    r.displacements = vec![vec![0.0; 3]; 4];
+    let ext = extent(&model, &step, Some(1.0));
+    let o = options();
+    let frame = draw_frame(&model, &step, &ext, &o).unwrap();
+    let tension = colour_at(&frame, &o, &ext, [0.5, 0.0, 0.0]);
+    let overloaded = colour_at(&frame, &o, &ext, [0.0, 0.5, 0.0]);
+    assert!(tension.0 > tension.2 + 0.2, "{tension:?}");
+    assert!(overloaded.0 < 0.1 && overloaded.2 < 0.1, "{overloaded:?}");
+}

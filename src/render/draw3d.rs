@@ -26,21 +26,61 @@ pub fn node_stresses(model: &ModelBody, stresses: &[Real]) -> Vec<Real> {
         .collect()
 }
 
-/// Unit vertex normals averaged over the adjacent triangles (weighted by area), for smooth
-/// shading; a vertex of no triangle gets +z.
-pub fn vertex_normals(positions: &[Vector3<Real>], triangles: &[[usize; 3]]) -> Vec<Vector3<Real>> {
-    let mut normals = vec![Vector3::zeros(); positions.len()];
+/// Cosine of the crease angle: adjacent patches meeting at more than 45° keep their own
+/// normals there (the edges of a box stay sharp), flatter ones are shaded smoothly.
+const CREASE_COS: Real = std::f64::consts::FRAC_1_SQRT_2;
+
+/// Unit normals at the three corners of every triangle: at each corner, the area-weighted
+/// mean of the normals of the triangles around that vertex that meet this one at less than
+/// the crease angle (smooth shading across smooth surfaces, sharp edges where they are sharp).
+pub fn corner_normals(
+    positions: &[Vector3<Real>],
+    triangles: &[[usize; 3]],
+) -> Vec<[Vector3<Real>; 3]> {
+    let face: Vec<Vector3<Real>> = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = [positions[t[0]], positions[t[1]], positions[t[2]]];
+            (b - a).cross(&(c - a))
+        })
+        .collect();
+    let unit: Vec<Vector3<Real>> = face
+        .iter()
+        .map(|n| n.try_normalize(1e-300).unwrap_or_else(Vector3::z))
+        .collect();
+    // Triangles around each vertex (compressed rows).
+    let mut start = vec![0usize; positions.len() + 1];
     for t in triangles {
-        let [a, b, c] = [positions[t[0]], positions[t[1]], positions[t[2]]];
-        let n = (b - a).cross(&(c - a));
-        for &k in t {
-            normals[k] += n;
+        for &v in t {
+            start[v + 1] += 1;
         }
     }
-    for n in &mut normals {
-        *n = n.try_normalize(1e-300).unwrap_or_else(Vector3::z);
+    for i in 0..positions.len() {
+        start[i + 1] += start[i];
     }
-    normals
+    let mut fill = start.clone();
+    let mut around = vec![0usize; start[positions.len()]];
+    for (k, t) in triangles.iter().enumerate() {
+        for &v in t {
+            around[fill[v]] = k;
+            fill[v] += 1;
+        }
+    }
+    triangles
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            t.map(|v| {
+                let mut n = Vector3::zeros();
+                for &s in &around[start[v]..start[v + 1]] {
+                    if unit[s].dot(&unit[k]) >= CREASE_COS {
+                        n += face[s];
+                    }
+                }
+                n.try_normalize(1e-300).unwrap_or(unit[k])
+            })
+        })
+        .collect()
 }
 
 /// A 3D body with patches: its surface shaded (coloured by the mean stress at the nodes or
@@ -79,7 +119,7 @@ pub fn shaded_surface(
         Colouring::Plain => vec![PLAIN_SURFACE; body.positions.len()],
     };
     out.push(Primitive::Surface(Mesh {
-        normals: vertex_normals(&body.positions, &triangles),
+        normals: corner_normals(&body.positions, &triangles),
         positions: body.positions.clone(),
         colours,
         triangles,

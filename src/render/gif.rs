@@ -51,6 +51,7 @@ impl GifAnimation {
             )));
         }
         let mut rgba = frame.rgba();
+        dither(&mut rgba, self.width as usize);
         let mut f = gif::Frame::from_rgba_speed(self.width, self.height, &mut rgba, 10);
         f.delay = if last { LAST_FRAME_DELAY } else { FRAME_DELAY };
         self.encoder.write_frame(&f).map_err(encode_error)?;
@@ -66,5 +67,21 @@ impl GifAnimation {
     /// The GIF file's bytes.
     pub fn finish(self) -> Result<Vec<u8>, RenderError> {
         self.encoder.into_inner().map_err(encode_error)
+    }
+}
+
+/// A light ordered (4×4 Bayer) dither of ±3 levels, so that 256 palette colours show smooth
+/// shading as fine grain instead of bands. Deterministic.
+fn dither(rgba: &mut [u8], width: usize) {
+    const BAYER: [[i16; 4]; 4] = [[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]];
+    for (i, px) in rgba.chunks_exact_mut(4).enumerate() {
+        let (x, y) = (i % width, i / width);
+        let d = (BAYER[y % 4][x % 4] * 2 - 15) * 2 / 5;
+        for c in &mut px[..3] {
+            // Leave pure white and black alone (background, text, overloaded members).
+            if *c != 255 && *c != 0 {
+                *c = (*c as i16 + d).clamp(0, 255) as u8;
+            }
+        }
     }
 }

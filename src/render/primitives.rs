@@ -12,14 +12,14 @@ pub enum Layer {
     Over,
 }
 
-/// A triangle mesh to shade: positions (m), unit outward normals per vertex, colours per
-/// vertex and triangles (0-based vertex indices, counter-clockwise seen from outside).
+/// A triangle mesh to shade: positions (m), colours per vertex, triangles (0-based vertex
+/// indices, counter-clockwise seen from outside) and unit outward normals per triangle corner.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     /// Vertex positions, m.
     pub positions: Vec<Vector3<Real>>,
-    /// Unit vertex normals (averaged over the adjacent triangles).
-    pub normals: Vec<Vector3<Real>>,
+    /// Unit normals at each triangle's corners (in the order of `triangles`).
+    pub normals: Vec<[Vector3<Real>; 3]>,
     /// Vertex colours.
     pub colours: Vec<Rgb>,
     /// Triangles.
@@ -216,23 +216,21 @@ fn rasterise_mesh(r: &mut Rasteriser, view: &View, ss: f32, mesh: &Mesh, lightin
             [q[0] * ss, q[1] * ss, q[2]]
         })
         .collect();
-    let normals: Vec<[f32; 3]> = mesh.normals.iter().map(|n| view.to_camera(n)).collect();
     let grey = Rgb(0.7, 0.7, 0.7);
-    for t in &mesh.triangles {
-        if t.iter()
-            .any(|&i| i >= projected.len() || i >= normals.len())
-        {
+    for (t, n) in mesh.triangles.iter().zip(&mesh.normals) {
+        if t.iter().any(|&i| i >= projected.len()) {
             continue;
         }
-        let vertex = |i: usize| {
+        let vertex = |k: usize| {
+            let i = t[k];
             let c = mesh.colours.get(i).copied().unwrap_or(grey);
             RasterVertex {
                 position: projected[i],
-                normal: normals[i],
+                normal: view.to_camera(&n[k]),
                 colour: [c.0, c.1, c.2],
             }
         };
-        r.triangle(&[vertex(t[0]), vertex(t[1]), vertex(t[2])], lighting);
+        r.triangle(&[vertex(0), vertex(1), vertex(2)], lighting);
     }
 }
 
