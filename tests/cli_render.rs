@@ -67,3 +67,36 @@ fn run_png_vtk_then_render_again_with_other_options() {
         "{err}"
     );
 }
+
+#[test]
+fn bundled_scenes_produce_their_frames_and_gifs() {
+    let out = tempfile::tempdir().unwrap();
+    let scenes: Vec<_> = std::fs::read_dir("scenes")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    assert!(scenes.len() >= 5);
+    let o = linkage()
+        .arg("run")
+        .args(&scenes)
+        .args(["--png", "--out"])
+        .arg(out.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    for entry in std::fs::read_dir(out.path()).unwrap() {
+        let dir = entry.unwrap().path();
+        let steps = std::fs::read_dir(dir.join("steps")).unwrap().count();
+        let frames = std::fs::read_dir(dir.join("png")).unwrap().count();
+        assert_eq!(frames, steps, "{}", dir.display());
+        let mut decoder = gif::DecodeOptions::new()
+            .read_info(std::fs::File::open(dir.join("anim.gif")).unwrap())
+            .unwrap();
+        let mut n = 0;
+        while decoder.read_next_frame().unwrap().is_some() {
+            n += 1;
+        }
+        assert_eq!(n, steps, "{}", dir.display());
+    }
+}

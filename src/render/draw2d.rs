@@ -4,7 +4,8 @@ use crate::render::{Colouring, Layer, Primitive, View};
 use crate::Real;
 
 /// Line widths, pixels at 720 pixels of frame height: (member, overloaded member, ghost).
-pub fn line_widths(body: &DeformedBody, view: &View) -> (f32, f32, f32) {
+/// `ui`: the frame's scale (see `overlay::ui_scale`).
+pub fn line_widths(body: &DeformedBody, view: &View, ui: f32) -> (f32, f32, f32) {
     // Thinner lines for finer meshes: a tenth of the typical member's length on screen.
     let mut lengths: Vec<f32> = body
         .model
@@ -18,7 +19,7 @@ pub fn line_widths(body: &DeformedBody, view: &View) -> (f32, f32, f32) {
         .collect();
     lengths.sort_by(|a, b| a.total_cmp(b));
     let typical = lengths.get(lengths.len() / 2).copied().unwrap_or(50.0);
-    let w = (typical * 0.045).clamp(0.6, 3.2);
+    let w = (typical / ui * 0.045).clamp(0.6, 3.2);
     (w, (w * 2.0).max(2.5), (w * 0.6).max(0.5))
 }
 
@@ -31,8 +32,9 @@ pub fn member_lines(
     view: &View,
     colouring: Colouring,
     scale: &ColourScale,
+    ui: f32,
 ) -> Vec<Primitive> {
-    let (width, heavy, ghost) = line_widths(body, view);
+    let (width, heavy, ghost) = line_widths(body, view, ui);
     let members = &body.model.members;
     let mut out = Vec::with_capacity(2 * members.len());
     let mut order: Vec<usize> = (0..members.len()).collect();

@@ -92,9 +92,10 @@ pub fn shaded_surface(
     colouring: Colouring,
     node_scale: &ColourScale,
     wireframe: bool,
+    ui: f32,
 ) -> Vec<Primitive> {
     let model = body.model;
-    let (width, heavy, ghost) = line_widths(body, view);
+    let (width, heavy, ghost) = line_widths(body, view, ui);
     let mut out = Vec::new();
     let members = &model.members;
     if members.len() <= 20_000 {

@@ -15,16 +15,27 @@ pub struct Layout {
     pub colour_bar: bool,
 }
 
+/// Scale of text, marks and line widths on a `width` × `height` frame: 1 at 1280 × 720,
+/// never below 0.7 so that text stays readable on small frames.
+pub fn ui_scale(width: u32, height: u32) -> f32 {
+    (height.min(width.saturating_mul(9) / 16) as f32 / 720.0).max(0.7)
+}
+
 impl Layout {
     /// The layout of a `width` × `height` frame, with or without a colour bar.
     pub fn new(width: u32, height: u32, colour_bar: bool) -> Self {
-        let ui = (height.min(width * 9 / 16).max(1) as f32 / 720.0).max(0.25);
+        let ui = ui_scale(width, height);
         let (w, h) = (width as Real, height as Real);
         let u = ui as Real;
         let right = if colour_bar { 220.0 * u } else { 40.0 * u };
+        let mut viewport = [40.0 * u, 100.0 * u, w - right, h - 60.0 * u];
+        // A frame too small for the furniture: the drawing gets the whole frame.
+        if viewport[2] - viewport[0] < 0.2 * w || viewport[3] - viewport[1] < 0.2 * h {
+            viewport = [0.0, 0.0, w, h];
+        }
         Layout {
             ui,
-            viewport: [40.0 * u, 100.0 * u, w - right, h - 60.0 * u],
+            viewport,
             colour_bar,
         }
     }

@@ -83,9 +83,16 @@ pub fn draw_frame(
                 options.colouring,
                 &node_scale,
                 options.wireframe,
+                layout.ui,
             ));
         } else {
-            primitives.extend(member_lines(&body, &view, options.colouring, &member_scale));
+            primitives.extend(member_lines(
+                &body,
+                &view,
+                options.colouring,
+                &member_scale,
+                layout.ui,
+            ));
         }
         primitives.extend(markers(&body, extent, shaded));
     }

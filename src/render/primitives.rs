@@ -95,7 +95,7 @@ pub fn paint(
     supersampling: u32,
     lighting: &Lighting,
 ) {
-    let ui = frame.height().min(frame.width() * 9 / 16).max(1) as f32 / 720.0;
+    let ui = crate::render::overlay::ui_scale(frame.width(), frame.height());
     let ss = supersampling.max(1) as usize;
     for p in primitives {
         if let Primitive::Line {
