@@ -404,22 +404,24 @@ fn render(a: &RenderArgs) -> Result<()> {
     let t = Instant::now();
     let report = render_run(&a.dir, &options)?;
     let seconds = t.elapsed().as_secs_f64();
-    println!(
-        "drew {} step{} of {} in {:.2} s (displacements ×{}): {} PNG frame{} in {}{}",
-        report.steps.len(),
-        if report.steps.len() == 1 { "" } else { "s" },
-        a.dir.display(),
-        seconds,
-        report.magnification,
-        report.frames.len(),
-        if report.frames.len() == 1 { "" } else { "s" },
-        a.dir.join("png").display(),
-        report
-            .gif
-            .as_ref()
-            .map(|g| format!(", {}", g.display()))
-            .unwrap_or_default()
-    );
+    if options.png || options.gif {
+        println!(
+            "drew {} step{} of {} in {:.2} s (displacements ×{}): {} PNG frame{} in {}{}",
+            report.steps.len(),
+            if report.steps.len() == 1 { "" } else { "s" },
+            a.dir.display(),
+            seconds,
+            report.magnification,
+            report.frames.len(),
+            if report.frames.len() == 1 { "" } else { "s" },
+            a.dir.join("png").display(),
+            report
+                .gif
+                .as_ref()
+                .map(|g| format!(", {}", g.display()))
+                .unwrap_or_default()
+        );
+    }
     if a.vtk {
         let run = StoredRun::open(&a.dir)?;
         let files = write_vtk(&run)?;

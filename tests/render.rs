@@ -418,3 +418,20 @@ fn a_3d_body_without_patches_is_drawn_as_coloured_lines() {
     assert!(tension.0 > tension.2 + 0.2, "{tension:?}");
     assert!(overloaded.0 < 0.1 && overloaded.2 < 0.1, "{overloaded:?}");
 }
+
+#[test]
+fn results_that_do_not_match_the_model_are_an_error_not_a_panic() {
+    let (model, mut step) = square();
+    let ext = extent(&model, &step, Some(1.0));
+    step.bodies[0].positions.pop();
+    let err = draw_frame(&model, &step, &ext, &options())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("does not match model.json"), "{err}");
+    let (mut model, step) = square();
+    model.bodies[0].members.push([1, 9]);
+    let err = draw_frame(&model, &step, &ext, &options())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("member 5"), "{err}");
+}

@@ -58,6 +58,11 @@ pub fn draw_frame(
     options: &RenderOptions,
 ) -> Result<Frame, RenderError> {
     options.check()?;
+    if let Some(problem) = model.problem().or_else(|| model.step_problem(step)) {
+        return Err(RenderError::Option {
+            message: format!("step {} cannot be drawn: {problem}", step.step),
+        });
+    }
     let mut frame = Frame::new(options.width, options.height)?;
     let stress = options.colouring == Colouring::Stress;
     let layout = Layout::new(options.width, options.height, stress);

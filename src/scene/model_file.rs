@@ -1,6 +1,7 @@
 //! `model.json`: the undeformed model of a run (what the step files do not repeat), written
 //! once per run so results can be drawn and exported again without the scene file.
 
+use crate::scene::results::StepResult;
 use crate::scene::World;
 use crate::Real;
 use serde::{Deserialize, Serialize};
@@ -129,6 +130,54 @@ impl ModelFile {
                 return Some(format!(
                     "body '{}': support names node {} outside 1..={n}",
                     b.name, s.node
+                ));
+            }
+        }
+        None
+    }
+
+    /// Whether `step` belongs to this model: the same bodies, one position and displacement
+    /// per node, one force and stress per member, and only existing nodes and members named.
+    /// Returns the problem.
+    pub fn step_problem(&self, step: &StepResult) -> Option<String> {
+        if step.bodies.len() != self.bodies.len() {
+            return Some(format!(
+                "has {} bodies but model.json has {}",
+                step.bodies.len(),
+                self.bodies.len()
+            ));
+        }
+        for (b, m) in step.bodies.iter().zip(&self.bodies) {
+            let n = m.nodes.len();
+            let per_node_ok =
+                |v: &[Vec<Real>]| v.len() == n && v.iter().all(|x| x.len() == m.dimension);
+            if b.name != m.name
+                || !per_node_ok(&b.positions)
+                || !per_node_ok(&b.displacements)
+                || b.axial_forces.len() != m.members.len()
+                || b.stresses.len() != m.members.len()
+            {
+                return Some(format!(
+                    "body '{}' does not match model.json (body '{}': {} nodes, {} members)",
+                    b.name,
+                    m.name,
+                    n,
+                    m.members.len()
+                ));
+            }
+            let node_ok = |k: usize| (1..=n).contains(&k);
+            let force_ok = |node: usize, f: &[Real]| node_ok(node) && f.len() == m.dimension;
+            if !b
+                .overloaded
+                .iter()
+                .all(|k| (1..=m.members.len()).contains(k))
+                || !b.loads.iter().all(|l| force_ok(l.node, &l.force))
+                || !b.reactions.iter().all(|l| force_ok(l.node, &l.force))
+                || !b.contacts.iter().all(|c| force_ok(c.node, &c.force))
+            {
+                return Some(format!(
+                    "body '{}' names a node or member that does not exist, or a force with the wrong number of components",
+                    b.name
                 ));
             }
         }

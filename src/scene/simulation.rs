@@ -120,13 +120,14 @@ impl<'w> Simulation<'w> {
 /// Run `world` and write `out/<name>/` (summary.json and steps/NNNN.json). The folder is
 /// built under a temporary name and renamed when complete, so an interrupted or failed run
 /// leaves no partial results (and an earlier complete run stays until replaced).
-/// `on_step` is called after each solved step (for progress bars).
+/// `on_step` is called after each solved step (for progress bars). Also writes `model.json`
+/// and the VTK files `world.pictures` asks for; pictures need [`run_with`].
 pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Summary, RunError> {
     run_with(world, out, on_step, None)
 }
 
-/// [`run`], also writing `model.json`, the VTK files and (through `draw`) the pictures that
-/// `world.pictures` asks for into the folder before it is published.
+/// [`run`], and the pictures `world.pictures` asks for, drawn by `draw` from the complete
+/// results in the folder before it is published (time in `phases.drawing`).
 pub fn run_with(
     world: &World,
     out: &Path,

@@ -116,60 +116,8 @@ impl StoredRun {
                 path: path.clone(),
                 problem: format!("not a step file ({e})"),
             })?;
-        let bad = |problem: String| StoredRunError::Bad {
-            path: path.clone(),
-            problem,
-        };
-        if result.bodies.len() != self.model.bodies.len() {
-            return Err(bad(format!(
-                "has {} bodies but model.json has {}",
-                result.bodies.len(),
-                self.model.bodies.len()
-            )));
-        }
-        for (b, m) in result.bodies.iter().zip(&self.model.bodies) {
-            let n = m.nodes.len();
-            let per_node_ok =
-                |v: &[Vec<f64>]| v.len() == n && v.iter().all(|x| x.len() == m.dimension);
-            if b.name != m.name
-                || !per_node_ok(&b.positions)
-                || !per_node_ok(&b.displacements)
-                || b.axial_forces.len() != m.members.len()
-                || b.stresses.len() != m.members.len()
-            {
-                return Err(bad(format!(
-                    "body '{}' does not match model.json (body '{}': {} nodes, {} members)",
-                    b.name,
-                    m.name,
-                    n,
-                    m.members.len()
-                )));
-            }
-            let node_ok = |k: usize| k >= 1 && k <= n;
-            let forces_ok = |f: &[Vec<f64>]| f.iter().all(|x| x.len() == m.dimension);
-            if !b.overloaded.iter().all(|&k| k >= 1 && k <= m.members.len())
-                || !b.loads.iter().all(|l| node_ok(l.node))
-                || !b.reactions.iter().all(|l| node_ok(l.node))
-                || !b.contacts.iter().all(|c| node_ok(c.node))
-                || !forces_ok(&b.loads.iter().map(|l| l.force.clone()).collect::<Vec<_>>())
-                || !forces_ok(
-                    &b.reactions
-                        .iter()
-                        .map(|l| l.force.clone())
-                        .collect::<Vec<_>>(),
-                )
-                || !forces_ok(
-                    &b.contacts
-                        .iter()
-                        .map(|l| l.force.clone())
-                        .collect::<Vec<_>>(),
-                )
-            {
-                return Err(bad(format!(
-                    "body '{}' names a node or member that does not exist, or a force with the wrong number of components",
-                    b.name
-                )));
-            }
+        if let Some(problem) = self.model.step_problem(&result) {
+            return Err(StoredRunError::Bad { path, problem });
         }
         Ok(result)
     }
