@@ -435,3 +435,23 @@ fn results_that_do_not_match_the_model_are_an_error_not_a_panic() {
         .to_string();
     assert!(err.contains("member 5"), "{err}");
 }
+
+#[test]
+fn bad_output_keys_name_the_scene_file() {
+    let base = std::fs::read_to_string("scenes/paper_square.toml").unwrap();
+    for (keys, expect) in [
+        ("width = 5", "[output] width = 5"),
+        ("magnification = -2.0", "[output] magnification = -2"),
+        ("elevation = 120.0", "[output] elevation = 120"),
+        ("png = \"yes\"", "png"),
+    ] {
+        let text = format!("{base}\n[output]\n{keys}\n");
+        let err = build_world(&text, Path::new("scenes/paper_square.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("paper_square.toml") && err.contains(expect),
+            "{keys}: {err}"
+        );
+    }
+}

@@ -189,3 +189,43 @@ fn vtu_files_parse_with_meshio_and_carry_the_step_values() {
     assert_eq!(v["cell_data"]["overloaded"][1][5].as_i64().unwrap(), 0);
     assert_eq!(v["points"][7][2].as_f64().unwrap(), b.positions[7][2]);
 }
+
+#[test]
+fn a_falling_load_plays_by_step_number_in_paraview() {
+    // ParaView needs increasing times: with a load that falls, the .pvd uses step numbers.
+    let text = r#"
+name = "falling"
+steps = 3
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "bar"
+rectangle = { width = 1.0, height = 0.5, cells = [2, 1] }
+[[bodies.supports]]
+nearest = [0.0, 0.0]
+fix = ["x", "y"]
+[[bodies.supports]]
+nearest = [1.0, 0.0]
+fix = ["y"]
+[[bodies.loads]]
+nearest = [1.0, 0.5]
+force = [100.0, 0.0]
+schedule = [1.0, 0.5, 0.25]
+[output]
+vtk = true
+"#;
+    let out = tempfile::tempdir().unwrap();
+    let world = linkage::scene::build_world(text, &out.path().join("s.toml")).unwrap();
+    run(&world, out.path(), &|| {}).unwrap();
+    let pvd = std::fs::read_to_string(out.path().join("falling/vtk/falling.pvd")).unwrap();
+    for k in 0..=3 {
+        assert!(
+            pvd.contains(&format!(
+                "timestep=\"{k}\" group=\"\" part=\"0\" file=\"{k:04}.vtu\""
+            )),
+            "{pvd}"
+        );
+    }
+}
