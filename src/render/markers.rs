@@ -57,6 +57,9 @@ pub fn markers(body: &DeformedBody, extent: &RunExtent, depth_test: bool) -> Vec
                 .map(|c| (c.node, &c.force, extent.contact_scale, CONTACT_ORANGE, 2.0)),
         );
     for (node, f, scale, colour, width) in forces {
+        if f.iter().all(|x| *x == 0.0) {
+            continue;
+        }
         let (tail, tip) = arrow_ends(body.at(node), vec3(f), scale, body.centre);
         out.push(Primitive::Arrow {
             tail,

@@ -156,20 +156,19 @@ pub fn paint(
                         layer: Layer::Over,
                         depth_test: true,
                     };
-                    let head = arrow_head(h, t, ui);
-                    let short = head.as_ref().map(|(base, _)| *base);
-                    draw_line_to(frame, view, raster.as_ref(), ss, &shaft, ui, short);
+                    let Some((base, path)) = arrow_head(h, t, ui) else {
+                        continue; // too short to see
+                    };
+                    draw_line_to(frame, view, raster.as_ref(), ss, &shaft, ui, Some(base));
                     if visible(raster.as_ref(), ss, view, h) {
-                        if let Some((_, path)) = head {
-                            let paint = paint_of(*colour, 1.0);
-                            frame.pixmap.fill_path(
-                                &path,
-                                &paint,
-                                FillRule::Winding,
-                                Transform::identity(),
-                                None,
-                            );
-                        }
+                        let paint = paint_of(*colour, 1.0);
+                        frame.pixmap.fill_path(
+                            &path,
+                            &paint,
+                            FillRule::Winding,
+                            Transform::identity(),
+                            None,
+                        );
                     }
                     continue;
                 }
