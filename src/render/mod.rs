@@ -15,7 +15,7 @@ pub use self::run_pictures::{render_run, select_steps, PictureWriter, RenderRepo
 
 mod bench;
 mod camera;
-pub mod colour_scale;
+mod colour_scale;
 mod deformed_body;
 mod draw2d;
 mod draw3d;
