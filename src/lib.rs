@@ -34,4 +34,5 @@ pub type Real = f64;
 pub mod atomic_file;
 pub mod bench;
 pub mod linkage;
+pub mod render;
 pub mod scene;

@@ -5,7 +5,7 @@ use crate::linkage::paper_files::{self, PaperFileError};
 use crate::linkage::{Body, Dimension, Geometry, Material, Member, NodalLoad, Schedule, Support};
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
-use crate::scene::{OutputSettings, World};
+use crate::scene::{OutputSettings, PictureSettings, World};
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -94,6 +94,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         },
         last_only: spec.output.last_only,
     };
+    let pictures = PictureSettings::from_spec(&spec.output).map_err(|e| at(top.clone(), e))?;
 
     let mut materials = Vec::new();
     for m in &spec.materials {
@@ -133,6 +134,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         steps: spec.steps,
         bodies,
         output,
+        pictures,
         source: path.to_path_buf(),
     })
 }
