@@ -152,11 +152,12 @@ pub struct IterativeTiming {
     pub peak_memory: u64,
 }
 
-/// Assemble a lattice and solve it with block-Jacobi conjugate gradients, timing each phase.
-pub fn measure_iterative(cells: [usize; 3]) -> Result<IterativeTiming, String> {
+/// Assemble a lattice and solve it with conjugate gradients preconditioned by smoothed
+/// aggregation (`multigrid`) or block Jacobi, timing each phase.
+pub fn measure_iterative(cells: [usize; 3], multigrid: bool) -> Result<IterativeTiming, String> {
     use crate::linkage::{
-        axial_stiffness, conjugate_gradient, BlockJacobi, CgSettings, DofMap, StiffnessAssembly,
-        SymmetricCsr,
+        axial_stiffness, conjugate_gradient, BlockJacobi, CgSettings, DofMap, Preconditioner,
+        SmoothedAggregation, StiffnessAssembly, SymmetricCsr,
     };
     let body = lattice_body(cells)?;
     let t = Instant::now();
@@ -177,7 +178,21 @@ pub fn measure_iterative(cells: [usize; 3]) -> Result<IterativeTiming, String> {
     drop(values);
     let assembly = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let m = BlockJacobi::new(&csr, &asm.groups).map_err(|e| e.to_string())?;
+    let mut m: Box<dyn Preconditioner> = if multigrid {
+        let directions: Vec<usize> = dofs.free.iter().map(|d| d % dofs.dofs_per_node).collect();
+        Box::new(
+            SmoothedAggregation::new(
+                &csr,
+                &asm.groups,
+                &directions,
+                &body.nodes,
+                dofs.dofs_per_node,
+            )
+            .map_err(|e| e.to_string())?,
+        )
+    } else {
+        Box::new(BlockJacobi::new(&csr, &asm.groups).map_err(|e| e.to_string())?)
+    };
     let setup = t.elapsed().as_secs_f64();
     let d = dofs.dofs_per_node;
     let mut b = vec![0.0; asm.n];
@@ -190,7 +205,7 @@ pub fn measure_iterative(cells: [usize; 3]) -> Result<IterativeTiming, String> {
     }
     let mut x = vec![0.0; asm.n];
     let t = Instant::now();
-    let report = conjugate_gradient(&csr, &m, &b, &mut x, CgSettings::default());
+    let report = conjugate_gradient(&csr, m.as_mut(), &b, &mut x, CgSettings::default());
     Ok(IterativeTiming {
         cells,
         members: body.members.len(),

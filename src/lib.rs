@@ -40,4 +40,5 @@ pub mod atomic_file;
 pub mod bench;
 pub mod bench_large;
 pub mod linkage;
+pub mod render;
 pub mod scene;

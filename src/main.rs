@@ -3,7 +3,8 @@
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use linkage::scene::{load_scene, run, Summary, World};
+use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
+use linkage::scene::{load_scene, run_with, Summary, World};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -33,7 +34,15 @@ enum Command {
         /// Scenes solved at once (default: the number of cores).
         #[arg(long)]
         jobs: Option<usize>,
+        /// Also draw png/NNNN.png per stored step and anim.gif (as `[output] png = true`).
+        #[arg(long)]
+        png: bool,
+        /// Also write vtk/NNNN.vtu per stored step and vtk/<scene>.pvd for ParaView.
+        #[arg(long)]
+        vtk: bool,
     },
+    /// Draw a stored run again (png/NNNN.png, anim.gif; --vtk for ParaView files) without solving.
+    Render(RenderArgs),
     /// Check scenes without solving and print model sizes.
     Check {
         /// Scene files (TOML).
@@ -54,9 +63,13 @@ enum Command {
         /// Lattice sizes in cells, e.g. 20x20x40 (default: a series up to over 1,000,000 members).
         #[arg(long = "cells", value_parser = parse_cells)]
         cells: Vec<[usize; 3]>,
-        /// Solve with block-Jacobi conjugate gradients instead of the direct solver.
+        /// Solve with conjugate gradients and smoothed-aggregation multigrid instead of the
+        /// direct solver.
         #[arg(long)]
         iterative: bool,
+        /// With --iterative: precondition with block Jacobi instead of multigrid.
+        #[arg(long, requires = "iterative")]
+        jacobi: bool,
         /// Measure in this process instead of one child process per size (then the peak
         /// memory column is the running maximum).
         #[arg(long, hide = true)]
@@ -71,7 +84,70 @@ enum Command {
         /// With --large: load steps (default 5).
         #[arg(long)]
         steps: Option<usize>,
+        /// Time drawing one frame of a shaded shell instead (see --patches, --size).
+        #[arg(long)]
+        render: bool,
+        /// With --render: surface patches of the shell.
+        #[arg(long, default_value_t = 100_000)]
+        patches: usize,
+        /// With --render: frame size WIDTHxHEIGHT.
+        #[arg(long, default_value = "1920x1080", value_parser = parse_size)]
+        size: [u32; 2],
     },
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// A results folder written by `linkage run` (DIR/<scene name>).
+    dir: PathBuf,
+    /// Frame width, pixels.
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    /// Frame height, pixels.
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Camera azimuth about +y, degrees from +z towards +x (default: 0 in 2D, 35 in 3D).
+    #[arg(long, allow_hyphen_values = true)]
+    azimuth: Option<f64>,
+    /// Camera elevation, degrees (default: 0 in 2D, 25 in 3D).
+    #[arg(long, allow_hyphen_values = true)]
+    elevation: Option<f64>,
+    /// Zoom over the view that fits the whole run.
+    #[arg(long, default_value_t = 1.0)]
+    zoom: f64,
+    /// "orthographic" or "perspective" (default: orthographic in 2D, perspective in 3D).
+    #[arg(long)]
+    projection: Option<Projection>,
+    /// Displacement magnification (default: automatic, 1 unless displacements are tiny).
+    #[arg(long)]
+    magnification: Option<f64>,
+    /// "stress" (compression blue, tension red) or "plain".
+    #[arg(long, default_value = "stress")]
+    colour: Colouring,
+    /// Draw the members over 3D surfaces.
+    #[arg(long)]
+    wireframe: bool,
+    /// Steps to draw: "all", "last" or numbers and ranges like 0,3,5-8.
+    #[arg(long, default_value = "all")]
+    steps: StepSelection,
+    /// Samples per pixel side for shaded surfaces (1-4).
+    #[arg(long, default_value_t = 2)]
+    supersampling: u32,
+    /// Do not write PNG frames.
+    #[arg(long)]
+    no_png: bool,
+    /// Do not write anim.gif.
+    #[arg(long)]
+    no_gif: bool,
+    /// Also write the ParaView files (vtk/NNNN.vtu, vtk/<scene>.pvd).
+    #[arg(long)]
+    vtk: bool,
+}
+
+fn parse_size(s: &str) -> Result<[u32; 2], String> {
+    let bad = || format!("{s:?}: give the frame size as WIDTHxHEIGHT, e.g. 1920x1080");
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    Ok([w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?])
 }
 
 fn parse_cells(s: &str) -> Result<[usize; 3], String> {
@@ -93,9 +169,22 @@ fn parse_cells(s: &str) -> Result<[usize; 3], String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
-        Command::Run { scenes, out, jobs } => run_scenes(&scenes, &out, jobs),
+        Command::Run {
+            scenes,
+            out,
+            jobs,
+            png,
+            vtk,
+        } => run_scenes(&scenes, &out, jobs, png, vtk),
         Command::Check { scenes } => check_scenes(&scenes),
         Command::Export { scene, out } => export(&scene, &out),
+        Command::Render(args) => render(&args),
+        Command::Bench {
+            render: true,
+            patches,
+            size,
+            ..
+        } => bench_render(patches, size),
         Command::Bench {
             cells,
             large: true,
@@ -106,9 +195,10 @@ fn main() -> ExitCode {
         Command::Bench {
             cells,
             iterative,
+            jacobi,
             in_process,
             ..
-        } => bench(cells, iterative, in_process),
+        } => bench(cells, iterative, jacobi, in_process),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -133,7 +223,13 @@ fn describe(world: &World) -> String {
     )
 }
 
-fn run_scenes(scenes: &[PathBuf], out: &Path, jobs: Option<usize>) -> Result<()> {
+fn run_scenes(
+    scenes: &[PathBuf],
+    out: &Path,
+    jobs: Option<usize>,
+    png: bool,
+    vtk: bool,
+) -> Result<()> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create the output folder {}", out.display()))?;
     let bar = ProgressBar::new(0);
@@ -144,9 +240,13 @@ fn run_scenes(scenes: &[PathBuf], out: &Path, jobs: Option<usize>) -> Result<()>
     );
     let one_scene = |path: &PathBuf| -> Result<(World, Summary, f64)> {
         let t = Instant::now();
-        let world = load_scene(path)?;
+        let mut world = load_scene(path)?;
+        if png {
+            world.pictures.ask_png();
+        }
+        world.pictures.vtk |= vtk;
         bar.inc_length(world.steps as u64 + 1);
-        let summary = run(&world, out, &|| bar.inc(1))?;
+        let summary = run_with(&world, out, &|| bar.inc(1), Some(&PictureWriter))?;
         Ok((world, summary, t.elapsed().as_secs_f64()))
     };
     let work =
@@ -293,14 +393,16 @@ const DEFAULT_BENCH: [[usize; 3]; 6] = [
     [43, 43, 43],
 ];
 
-fn bench(cells: Vec<[usize; 3]>, iterative: bool, in_process: bool) -> Result<()> {
+fn bench(cells: Vec<[usize; 3]>, iterative: bool, jacobi: bool, in_process: bool) -> Result<()> {
     let sizes = if cells.is_empty() {
         DEFAULT_BENCH.to_vec()
     } else {
         cells
     };
-    let what = if iterative {
+    let what = if iterative && jacobi {
         "block-Jacobi conjugate gradients to 1e-10"
+    } else if iterative {
+        "smoothed-aggregation multigrid conjugate gradients to 1e-10"
     } else {
         "direct sparse Cholesky (METIS order)"
     };
@@ -312,7 +414,7 @@ fn bench(cells: Vec<[usize; 3]>, iterative: bool, in_process: bool) -> Result<()
     }
     for c in sizes {
         if in_process && iterative {
-            let t = linkage::bench::measure_iterative(c).map_err(anyhow::Error::msg)?;
+            let t = linkage::bench::measure_iterative(c, !jacobi).map_err(anyhow::Error::msg)?;
             println!("{}", linkage::bench::format_iterative_row(&t));
         } else if in_process {
             let t = linkage::bench::measure_lattice(c).map_err(anyhow::Error::msg)?;
@@ -323,6 +425,9 @@ fn bench(cells: Vec<[usize; 3]>, iterative: bool, in_process: bool) -> Result<()
             let mut args = vec!["bench".to_string(), "--in-process".to_string()];
             if iterative {
                 args.push("--iterative".to_string());
+            }
+            if jacobi {
+                args.push("--jacobi".to_string());
             }
             args.extend(["--cells".to_string(), format!("{}x{}x{}", c[0], c[1], c[2])]);
             let output = std::process::Command::new(exe)
@@ -341,5 +446,83 @@ fn bench(cells: Vec<[usize; 3]>, iterative: bool, in_process: bool) -> Result<()
             }
         }
     }
+    Ok(())
+}
+
+fn render(a: &RenderArgs) -> Result<()> {
+    use linkage::render::{render_run, RenderOptions};
+    use linkage::scene::{write_vtk, StoredRun};
+    // A published results folder always has its summary: without it the folder is not one.
+    let summary = a.dir.join("summary.json");
+    if !summary.is_file() {
+        bail!(
+            "{}: no summary.json: give a results folder written by `linkage run SCENE --out DIR` (DIR/<scene name>)",
+            a.dir.display()
+        );
+    }
+    let options = RenderOptions {
+        width: a.width,
+        height: a.height,
+        azimuth: a.azimuth,
+        elevation: a.elevation,
+        zoom: a.zoom,
+        projection: a.projection,
+        magnification: a.magnification,
+        colouring: a.colour,
+        wireframe: a.wireframe,
+        steps: a.steps.clone(),
+        png: !a.no_png,
+        gif: !a.no_gif,
+        supersampling: a.supersampling,
+    };
+    let t = Instant::now();
+    let report = render_run(&a.dir, &options)?;
+    let seconds = t.elapsed().as_secs_f64();
+    if options.png || options.gif {
+        println!(
+            "drew {} step{} of {} in {:.2} s (displacements ×{}): {} PNG frame{} in {}{}",
+            report.steps.len(),
+            if report.steps.len() == 1 { "" } else { "s" },
+            a.dir.display(),
+            seconds,
+            report.magnification,
+            report.frames.len(),
+            if report.frames.len() == 1 { "" } else { "s" },
+            a.dir.join("png").display(),
+            report
+                .gif
+                .as_ref()
+                .map(|g| format!(", {}", g.display()))
+                .unwrap_or_default()
+        );
+    }
+    if a.vtk {
+        let run = StoredRun::open(&a.dir)?;
+        let files = write_vtk(&run)?;
+        println!(
+            "wrote {} ParaView files in {}",
+            files.len(),
+            a.dir.join("vtk").display()
+        );
+    }
+    Ok(())
+}
+
+fn bench_render(patches: usize, size: [u32; 2]) -> Result<()> {
+    let t = linkage::render::render_benchmark(patches, size[0], size[1], 3)
+        .map_err(anyhow::Error::msg)?;
+    println!("Rendering: one frame of a bent cylindrical shell, shaded and stress-coloured (supersampling 2x2), best of 3");
+    println!(
+        "{:>9} {:>9} {:>11} {:>10} {:>10}",
+        "patches", "members", "pixels", "draw s", "PNG s"
+    );
+    println!(
+        "{:>9} {:>9} {:>11} {:>10.3} {:>10.3}",
+        t.patches,
+        t.members,
+        format!("{}x{}", t.size[0], t.size[1]),
+        t.draw,
+        t.png
+    );
     Ok(())
 }

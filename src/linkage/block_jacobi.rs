@@ -1,6 +1,6 @@
 //! The block-Jacobi preconditioner: the inverse of each node's 2×2 or 3×3 diagonal block.
 
-use crate::linkage::SymmetricCsr;
+use crate::linkage::{Preconditioner, SymmetricCsr};
 use crate::Real;
 use nalgebra::{DMatrix, Matrix3};
 use rayon::prelude::*;
@@ -71,7 +71,7 @@ impl BlockJacobi {
     }
 
     /// `z = M⁻¹ r`, DOFs in parallel.
-    pub fn apply(&self, r: &[Real], z: &mut [Real]) {
+    pub fn apply_inverse(&self, r: &[Real], z: &mut [Real]) {
         z.par_chunks_mut(2048).enumerate().for_each(|(chunk, out)| {
             let first = chunk * 2048;
             for (k, zi) in out.iter_mut().enumerate() {
@@ -83,5 +83,11 @@ impl BlockJacobi {
                 *zi = (0..size).map(|j| inv[(i - s, j)] * r[s + j]).sum();
             }
         });
+    }
+}
+
+impl Preconditioner for BlockJacobi {
+    fn apply(&mut self, _: &SymmetricCsr, r: &[Real], z: &mut [Real]) {
+        self.apply_inverse(r, z);
     }
 }

@@ -1,7 +1,7 @@
 //! Preconditioned conjugate gradients for `K_ff U_f = F_f` (paper Eq. 8) on bodies too large to
 //! factor, warm-started from the best guess at hand.
 
-use crate::linkage::{dot, BlockJacobi, SymmetricCsr};
+use crate::linkage::{dot, Preconditioner, SymmetricCsr};
 use crate::Real;
 use rayon::prelude::*;
 
@@ -38,10 +38,10 @@ pub struct CgReport {
 }
 
 /// Solve `A x = b` from the initial guess in `x` (warm start; zeros for a cold one) with
-/// block-Jacobi preconditioned conjugate gradients. `x` holds the last iterate on return.
+/// preconditioned conjugate gradients. `x` holds the last iterate on return.
 pub fn conjugate_gradient(
     a: &SymmetricCsr,
-    m: &BlockJacobi,
+    m: &mut dyn Preconditioner,
     b: &[Real],
     x: &mut [Real],
     settings: CgSettings,
@@ -73,7 +73,7 @@ pub fn conjugate_gradient(
         if r_norm <= target || report.iterations >= settings.max_iterations || report.breakdown {
             break;
         }
-        m.apply(&r, &mut z);
+        m.apply(a, &r, &mut z);
         p.copy_from_slice(&z);
         let mut rz = dot(&r, &z);
         while r_norm > target && report.iterations < settings.max_iterations {
@@ -90,7 +90,7 @@ pub fn conjugate_gradient(
             r.par_iter_mut()
                 .zip(&q)
                 .for_each(|(ri, qi)| *ri -= alpha * qi);
-            m.apply(&r, &mut z);
+            m.apply(a, &r, &mut z);
             let rz_next = dot(&r, &z);
             let beta = rz_next / rz;
             rz = rz_next;
@@ -111,7 +111,7 @@ mod tests {
     use super::*;
     use crate::linkage::cholesky::SparseCholesky;
     use crate::linkage::{
-        generators, member_block, Body, DofMap, Material, StiffnessAssembly, Support,
+        generators, member_block, BlockJacobi, Body, DofMap, Material, StiffnessAssembly, Support,
     };
 
     /// `K_ff` of a small lattice with its bottom fixed, as assembly, values and full rows.
@@ -154,9 +154,9 @@ mod tests {
             SparseCholesky::analyze(asm.n, &asm.col_ptr, &asm.row_idx, Some(&asm.groups)).unwrap();
         chol.factorize(&values).unwrap();
         chol.solve_in_place(&mut direct);
-        let m = BlockJacobi::new(&csr, &asm.groups).unwrap();
+        let mut m = BlockJacobi::new(&csr, &asm.groups).unwrap();
         let mut x = vec![0.0; asm.n];
-        let cold = conjugate_gradient(&csr, &m, &b, &mut x, CgSettings::default());
+        let cold = conjugate_gradient(&csr, &mut m, &b, &mut x, CgSettings::default());
         assert!(cold.converged && cold.residual <= 1e-10, "{cold:?}");
         let scale = direct.iter().map(|v| v.abs()).fold(0.0, Real::max);
         let err = x
@@ -171,7 +171,7 @@ mod tests {
         // A nearby right-hand side from the previous answer needs fewer iterations.
         let b2: Vec<Real> = b.iter().map(|v| 1.1 * v).collect();
         let mut warm: Vec<Real> = x.iter().map(|v| 1.05 * v).collect();
-        let warm_report = conjugate_gradient(&csr, &m, &b2, &mut warm, CgSettings::default());
+        let warm_report = conjugate_gradient(&csr, &mut m, &b2, &mut warm, CgSettings::default());
         assert!(warm_report.converged);
         assert!(
             warm_report.iterations < cold.iterations,
@@ -186,7 +186,7 @@ mod tests {
             .build()
             .unwrap();
         let single =
-            pool.install(|| conjugate_gradient(&csr, &m, &b, &mut one, CgSettings::default()));
+            pool.install(|| conjugate_gradient(&csr, &mut m, &b, &mut one, CgSettings::default()));
         assert_eq!(single.iterations, cold.iterations);
         assert_eq!(one, x);
     }
@@ -195,13 +195,13 @@ mod tests {
     fn an_unreachable_tolerance_is_reported_not_hidden() {
         let (asm, _, csr) = lattice();
         let b = vec![1.0; asm.n];
-        let m = BlockJacobi::new(&csr, &asm.groups).unwrap();
+        let mut m = BlockJacobi::new(&csr, &asm.groups).unwrap();
         let mut x = vec![0.0; asm.n];
         let settings = CgSettings {
             tolerance: 1e-30,
             max_iterations: 50,
         };
-        let r = conjugate_gradient(&csr, &m, &b, &mut x, settings);
+        let r = conjugate_gradient(&csr, &mut m, &b, &mut x, settings);
         assert!(!r.converged);
         assert_eq!(r.iterations, 50);
         assert!(r.residual.is_finite() && r.residual > 1e-30);

@@ -19,8 +19,9 @@ pub use self::mechanism::Mechanism;
 pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
 pub use self::newton::NewtonEquilibrium;
+pub use self::smoothed_aggregation::{MultigridError, SmoothedAggregation};
 pub use self::step_state::StepState;
-pub use self::symmetric_csr::{dot, SymmetricCsr};
+pub use self::symmetric_csr::{dot, Preconditioner, SymmetricCsr};
 
 mod assembly;
 mod block_jacobi;
@@ -41,6 +42,7 @@ mod member_stiffness;
 mod newton;
 pub mod ordering;
 pub mod paper_files;
+mod smoothed_aggregation;
 mod step_state;
 mod symmetric_csr;
 mod tangent_solver;

@@ -77,6 +77,20 @@ impl SymmetricCsr {
         csr
     }
 
+    /// A matrix given directly by its full rows (columns ascending in each row); it has no
+    /// lower-triangle map, so [`SymmetricCsr::refill`] does not apply to it.
+    pub fn from_rows(n: usize, row_ptr: Vec<usize>, col: Vec<u32>, val: Vec<Real>) -> Self {
+        let csr = SymmetricCsr {
+            n,
+            row_ptr,
+            col,
+            val,
+            from_lower: Vec::new(),
+        };
+        csr.check_sorted();
+        csr
+    }
+
     fn check_sorted(&self) {
         debug_assert!((0..self.n).all(|i| {
             self.col[self.row_ptr[i]..self.row_ptr[i + 1]]
@@ -125,6 +139,13 @@ impl SymmetricCsr {
                 }
             });
     }
+}
+
+/// An approximate inverse of a symmetric positive definite matrix, applied once per
+/// conjugate-gradient iteration.
+pub trait Preconditioner {
+    /// `z = M⁻¹ r` for the matrix `a`.
+    fn apply(&mut self, a: &SymmetricCsr, r: &[Real], z: &mut [Real]);
 }
 
 /// `Σ a_i b_i`, summed in fixed chunks whose partial sums are added in order: the same

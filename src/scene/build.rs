@@ -8,7 +8,7 @@ use crate::linkage::{
 };
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
-use crate::scene::{OutputSettings, World};
+use crate::scene::{OutputSettings, PictureSettings, World};
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -97,6 +97,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         },
         last_only: spec.output.last_only,
     };
+    let pictures = PictureSettings::from_spec(&spec.output).map_err(|e| at(top.clone(), e))?;
 
     let mut materials = Vec::new();
     for m in &spec.materials {
@@ -136,6 +137,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         steps: spec.steps,
         bodies,
         output,
+        pictures,
         source: path.to_path_buf(),
     })
 }

@@ -1,16 +1,26 @@
 //! Scene files, the load-step driver and the result files.
 
 pub use self::build::{build_world, load_scene, SceneError};
+pub use self::extra_outputs::DrawResults;
+pub use self::model_file::{ModelBody, ModelFile, SupportedNode};
+pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::results::{
     BodyResult, BodySize, ContactForce, NodeForce, PhaseSeconds, StepResult, StepSummary, Summary,
 };
 pub use self::selector::select_nodes;
-pub use self::simulation::{run, RunError, Simulation};
+pub use self::simulation::{run, run_with, RunError, Simulation};
+pub use self::stored_run::{StoredRun, StoredRunError};
+pub use self::vtk::{write_vtk, VtkError};
 pub use self::world::{OutputSettings, World};
 
 mod build;
+mod extra_outputs;
+mod model_file;
+mod pictures;
 mod results;
 mod selector;
 mod simulation;
 pub mod spec;
+mod stored_run;
+mod vtk;
 mod world;

@@ -127,6 +127,9 @@ pub struct PhaseSeconds {
     pub solve: Real,
     /// Writing result files.
     pub writing: Real,
+    /// Drawing pictures (PNG frames, GIF) of the stored steps.
+    #[serde(default)]
+    pub drawing: Real,
 }
 
 /// `summary.json`.

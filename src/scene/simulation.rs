@@ -2,6 +2,7 @@
 
 use crate::atomic_file::write_atomically;
 use crate::linkage::{BodySolver, SolveError};
+use crate::scene::extra_outputs::{write_extra_outputs, DrawResults};
 use crate::scene::results::{BodyResult, BodySize, PhaseSeconds, StepResult, StepSummary, Summary};
 use crate::scene::World;
 use crate::Real;
@@ -35,6 +36,14 @@ pub enum RunError {
         path: PathBuf,
         /// The OS error.
         source: std::io::Error,
+    },
+    /// Pictures or VTK files could not be made.
+    #[error("{path}: {message}")]
+    Draw {
+        /// Results folder or file.
+        path: PathBuf,
+        /// What went wrong and what to do.
+        message: String,
     },
 }
 
@@ -126,8 +135,20 @@ impl<'w> Simulation<'w> {
 /// Run `world` and write `out/<name>/` (summary.json and steps/NNNN.json). The folder is
 /// built under a temporary name and renamed when complete, so an interrupted or failed run
 /// leaves no partial results (and an earlier complete run stays until replaced).
-/// `on_step` is called after each solved step (for progress bars).
+/// `on_step` is called after each solved step (for progress bars). Also writes `model.json`
+/// and the VTK files `world.pictures` asks for; pictures need [`run_with`].
 pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Summary, RunError> {
+    run_with(world, out, on_step, None)
+}
+
+/// [`run`], and the pictures `world.pictures` asks for, drawn by `draw` from the complete
+/// results in the folder before it is published (time in `phases.drawing`).
+pub fn run_with(
+    world: &World,
+    out: &Path,
+    on_step: &(dyn Fn() + Sync),
+    draw: Option<&dyn DrawResults>,
+) -> Result<Summary, RunError> {
     let write_err = |path: &Path| {
         let path = path.to_path_buf();
         move |source| RunError::Write { path, source }
@@ -195,6 +216,7 @@ pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Sum
             summary.phases.numeric += times.numeric;
             summary.phases.solve += times.solve;
         }
+        write_extra_outputs(world, &staging, draw, &mut summary.phases)?;
         let path = staging.join("summary.json");
         let bytes = serde_json::to_vec_pretty(&summary).map_err(|e| RunError::Write {
             path: path.clone(),

@@ -261,7 +261,7 @@ pub struct LoadSpec {
     pub schedule: Option<Vec<Real>>,
 }
 
-/// `[output]`: which steps are written.
+/// `[output]`: which steps are written, pictures and VTK files.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
@@ -270,6 +270,22 @@ pub struct OutputSpec {
     /// Write only the last step (and step 0).
     #[serde(default)]
     pub last_only: bool,
+    /// Pictures and VTK files: see [`crate::scene::PictureSettings`].
+    pub png: Option<bool>,
+    /// Animated GIF (default: as `png`).
+    pub gif: Option<bool>,
+    /// ParaView files.
+    pub vtk: Option<bool>,
+    /// Frame width, pixels.
+    pub width: Option<u32>,
+    /// Frame height, pixels.
+    pub height: Option<u32>,
+    /// Displacement magnification (default automatic).
+    pub magnification: Option<Real>,
+    /// Camera azimuth, degrees.
+    pub azimuth: Option<Real>,
+    /// Camera elevation, degrees.
+    pub elevation: Option<Real>,
 }
 
 macro_rules! selector_of {

@@ -1,4 +1,5 @@
 use crate::linkage::{Body, Schedule};
+use crate::scene::PictureSettings;
 use crate::Real;
 use std::path::PathBuf;
 
@@ -38,6 +39,8 @@ pub struct World {
     pub bodies: Vec<Body>,
     /// Which steps to write.
     pub output: OutputSettings,
+    /// Pictures and VTK files to write.
+    pub pictures: PictureSettings,
     /// The scene file it came from.
     pub source: PathBuf,
 }

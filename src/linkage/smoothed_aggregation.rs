@@ -1,0 +1,866 @@
+//! Smoothed-aggregation algebraic multigrid: a preconditioner for conjugate gradients on large
+//! linkages, with the rigid-body motions of the linkage as the near-null space.
+//!
+//! Nodes are grouped into aggregates (a node and its neighbours); on each aggregate the
+//! rigid-body motions, orthonormalised, make the tentative prolongator `P₀`; one damped
+//! Jacobi step smooths it, `P = (I − ω D⁻¹A) P₀`; the coarse matrix is `PᵀAP`. Levels repeat
+//! until the matrix is small enough to factor. One V-cycle with Chebyshev smoothing (a fixed
+//! polynomial in `D⁻¹A`, so the cycle is symmetric) is one application of the preconditioner.
+
+use crate::linkage::cholesky::SparseCholesky;
+use crate::linkage::{dot, Preconditioner, SymmetricCsr};
+use crate::Real;
+use nalgebra::Vector3;
+use rayon::prelude::*;
+
+/// Factor the level directly once it has at most this many unknowns.
+const COARSE_SIZE: usize = 3000;
+/// Rows per parallel task.
+const ROWS_PER_TASK: usize = 1024;
+/// Degree of the Chebyshev smoother.
+const SMOOTHER_DEGREE: usize = 2;
+/// The smoother damps eigenvalues of `D⁻¹A` in `[λmax / RATIO, 1.1 λmax]`.
+const SMOOTHER_RATIO: Real = 20.0;
+
+/// Near-null-space modes carried per aggregate: the 6 rigid-body motions in 3D (3 in 2D).
+const MODES: usize = 6;
+
+/// A transfer operator between a level and the next coarser one, stored by aggregate: row i
+/// holds one `MODES`-value segment per aggregate it touches (the coarse DOFs of an aggregate
+/// are consecutive, `rank[g]` of them from `offset[g]`). Working per aggregate instead of per
+/// coarse DOF makes one index lookup serve six values.
+#[derive(Clone, Debug, Default)]
+struct AggregateRows {
+    row_ptr: Vec<usize>,
+    aggregate: Vec<u32>,
+    value: Vec<[Real; MODES]>,
+}
+
+impl AggregateRows {
+    fn rows(&self) -> usize {
+        self.row_ptr.len() - 1
+    }
+}
+
+/// The coarse DOFs of each aggregate: `offset[g]..offset[g] + rank[g]`.
+#[derive(Clone, Debug, Default)]
+struct CoarseNumbering {
+    offset: Vec<usize>,
+    rank: Vec<usize>,
+}
+
+/// For each aggregate, the (fine row, entry) pairs of the prolongator that touch it: the
+/// transpose, for restriction and the Galerkin product.
+fn by_aggregate(p: &AggregateRows, count: usize) -> (Vec<usize>, Vec<(u32, u32)>) {
+    let mut start = vec![0usize; count + 1];
+    for &g in &p.aggregate {
+        start[g as usize + 1] += 1;
+    }
+    for g in 0..count {
+        start[g + 1] += start[g];
+    }
+    let mut next = start.clone();
+    let mut pairs = vec![(0u32, 0u32); p.aggregate.len()];
+    for i in 0..p.rows() {
+        for e in p.row_ptr[i]..p.row_ptr[i + 1] {
+            let g = p.aggregate[e] as usize;
+            pairs[next[g]] = (i as u32, e as u32);
+            next[g] += 1;
+        }
+    }
+    (start, pairs)
+}
+
+/// Rows built by one parallel task: their lengths, aggregates and value segments.
+type RowChunk = (Vec<usize>, Vec<u32>, Vec<[Real; MODES]>);
+
+/// Per-chunk rows, concatenated in chunk order.
+fn concatenate(chunks: Vec<RowChunk>) -> AggregateRows {
+    let nnz: usize = chunks.iter().map(|c| c.1.len()).sum();
+    let mut m = AggregateRows {
+        row_ptr: vec![0],
+        aggregate: Vec::with_capacity(nnz),
+        value: Vec::with_capacity(nnz),
+    };
+    for (lengths, aggregates, values) in chunks {
+        for l in lengths {
+            let last = m.row_ptr[m.row_ptr.len() - 1];
+            m.row_ptr.push(last + l);
+        }
+        m.aggregate.extend(aggregates);
+        m.value.extend(values);
+    }
+    m
+}
+
+/// Accumulates `MODES`-value segments by aggregate for one row at a time.
+struct RowAccumulator {
+    place: Vec<u32>,
+    aggregates: Vec<u32>,
+    values: Vec<[Real; MODES]>,
+}
+
+impl RowAccumulator {
+    fn new(count: usize) -> Self {
+        RowAccumulator {
+            place: vec![u32::MAX; count],
+            aggregates: Vec::new(),
+            values: Vec::new(),
+        }
+    }
+
+    fn add(&mut self, g: u32, scale: Real, v: &[Real; MODES]) {
+        let slot = &mut self.place[g as usize];
+        if *slot == u32::MAX {
+            *slot = self.aggregates.len() as u32;
+            self.aggregates.push(g);
+            self.values.push(v.map(|x| scale * x));
+        } else {
+            let target = &mut self.values[*slot as usize];
+            for k in 0..MODES {
+                target[k] += scale * v[k];
+            }
+        }
+    }
+
+    /// Move the row into the chunk's output and reset.
+    fn finish(&mut self, out: &mut RowChunk) {
+        out.0.push(self.aggregates.len());
+        for &g in &self.aggregates {
+            self.place[g as usize] = u32::MAX;
+        }
+        out.1.append(&mut self.aggregates);
+        out.2.append(&mut self.values);
+    }
+}
+
+/// One level of the hierarchy: its matrix (except on the finest, which the caller owns), the
+/// smoother's data, and the transfer to the next level.
+struct Level {
+    matrix: Option<SymmetricCsr>,
+    inverse_diagonal: Vec<Real>,
+    lambda_max: Real,
+    prolongator: AggregateRows,
+    numbering: CoarseNumbering,
+    /// `by_aggregate` of the prolongator: start per aggregate, (fine row, entry) pairs.
+    transpose: (Vec<usize>, Vec<(u32, u32)>),
+}
+
+impl Level {
+    /// `x += P xc`.
+    fn prolong_add(&self, coarse: &[Real], x: &mut [Real]) {
+        let p = &self.prolongator;
+        let nb = &self.numbering;
+        x.par_chunks_mut(ROWS_PER_TASK)
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                let first = chunk * ROWS_PER_TASK;
+                for (k, xi) in out.iter_mut().enumerate() {
+                    let i = first + k;
+                    for e in p.row_ptr[i]..p.row_ptr[i + 1] {
+                        let g = p.aggregate[e] as usize;
+                        let v = &p.value[e];
+                        let c = &coarse[nb.offset[g]..nb.offset[g] + nb.rank[g]];
+                        *xi += c.iter().zip(v).map(|(a, b)| a * b).sum::<Real>();
+                    }
+                }
+            });
+    }
+
+    /// `bc = Pᵀ r`, aggregates in parallel.
+    fn restrict(&self, r: &[Real], coarse: &mut [Real]) {
+        let (start, pairs) = &self.transpose;
+        let p = &self.prolongator;
+        let nb = &self.numbering;
+        let sums: Vec<[Real; MODES]> = (0..nb.rank.len())
+            .into_par_iter()
+            .with_min_len(256)
+            .map(|g| {
+                let mut acc = [0.0; MODES];
+                for &(i, e) in &pairs[start[g]..start[g + 1]] {
+                    let ri = r[i as usize];
+                    for (a, v) in acc.iter_mut().zip(&p.value[e as usize]) {
+                        *a += v * ri;
+                    }
+                }
+                acc
+            })
+            .collect();
+        for (g, acc) in sums.iter().enumerate() {
+            coarse[nb.offset[g]..nb.offset[g] + nb.rank[g]].copy_from_slice(&acc[..nb.rank[g]]);
+        }
+    }
+}
+
+/// The multigrid hierarchy: apply it with [`SmoothedAggregation::apply`].
+pub struct SmoothedAggregation {
+    levels: Vec<Level>,
+    coarse: SparseCholesky,
+    /// Unknowns per level, finest first (the last is factored).
+    pub sizes: Vec<usize>,
+}
+
+/// Why the hierarchy could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MultigridError {
+    /// A zero or negative diagonal entry: nothing holds that DOF.
+    #[error(
+        "free DOF {dof} has no stiffness of its own: nothing holds that node in that direction"
+    )]
+    NoStiffness {
+        /// Free DOF.
+        dof: usize,
+    },
+    /// The coarsest matrix could not be factored.
+    #[error("the coarsest multigrid level could not be factored: {0}")]
+    Coarse(String),
+}
+
+impl SmoothedAggregation {
+    /// The hierarchy for `K_ff` of a body: `groups` is the node of each free DOF (a node's DOFs
+    /// consecutive), `directions` the direction (0, 1, 2) of each free DOF, `nodes` the node
+    /// positions (m), `dimension` 2 or 3.
+    pub fn new(
+        matrix: &SymmetricCsr,
+        groups: &[usize],
+        directions: &[usize],
+        nodes: &[Vector3<Real>],
+        dimension: usize,
+    ) -> Result<Self, MultigridError> {
+        Self::with_coarse_size(matrix, groups, directions, nodes, dimension, COARSE_SIZE)
+    }
+
+    /// As [`SmoothedAggregation::new`], factoring the first level with at most `coarse_size`
+    /// unknowns.
+    pub fn with_coarse_size(
+        matrix: &SymmetricCsr,
+        groups: &[usize],
+        directions: &[usize],
+        nodes: &[Vector3<Real>],
+        dimension: usize,
+        coarse_size: usize,
+    ) -> Result<Self, MultigridError> {
+        // Near-null space: the rigid-body motions about the centroid (conditioning).
+        let centre = nodes.iter().sum::<Vector3<Real>>() / nodes.len().max(1) as Real;
+        let mut null_space = vec![[0.0; MODES]; matrix.n];
+        for (i, row) in null_space.iter_mut().enumerate() {
+            let p = nodes[groups[i]] - centre;
+            let d = directions[i];
+            row[d] = 1.0;
+            if dimension == 2 {
+                // Rotation about z: (−y, x).
+                row[2] = if d == 0 { -p.y } else { p.x };
+            } else {
+                // Rotations about x, y, z: a × p.
+                let rx = Vector3::new(0.0, -p.z, p.y);
+                let ry = Vector3::new(p.z, 0.0, -p.x);
+                let rz = Vector3::new(-p.y, p.x, 0.0);
+                row[3] = rx[d];
+                row[4] = ry[d];
+                row[5] = rz[d];
+            }
+        }
+        let mut starts: Vec<usize> = Vec::new();
+        for (i, g) in groups.iter().enumerate() {
+            if i == 0 || groups[i - 1] != *g {
+                starts.push(i);
+            }
+        }
+        starts.push(groups.len());
+
+        let mut levels = Vec::new();
+        let mut sizes = vec![matrix.n];
+        let mut current: Option<SymmetricCsr> = None;
+        let mut blocks = starts;
+        loop {
+            let a = current.as_ref().unwrap_or(matrix);
+            if a.n <= coarse_size {
+                break;
+            }
+            let inverse_diagonal = a
+                .diagonal()
+                .iter()
+                .enumerate()
+                .map(|(i, &d)| {
+                    if d > 0.0 {
+                        Ok(1.0 / d)
+                    } else {
+                        Err(MultigridError::NoStiffness { dof: i })
+                    }
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            let lambda_max = largest_eigenvalue(a, &inverse_diagonal);
+            let aggregates = aggregate(a, &blocks);
+            let count = aggregates
+                .iter()
+                .copied()
+                .max()
+                .map_or(0, |m| m as usize + 1);
+            if count * 2 > blocks.len() - 1 {
+                // Aggregation no longer coarsens: factor this level.
+                break;
+            }
+            let (tentative, numbering, coarse_null) =
+                tentative_prolongator(&blocks, &aggregates, count, &null_space);
+            let omega = 4.0 / (3.0 * lambda_max);
+            let prolongator = smooth_prolongator(a, &inverse_diagonal, omega, &tentative, count);
+            drop(tentative);
+            let transpose = by_aggregate(&prolongator, count);
+            let coarse = galerkin(a, &prolongator, &transpose, &numbering);
+            sizes.push(coarse.n);
+            let mut coarse_blocks = numbering.offset.clone();
+            coarse_blocks.push(coarse.n);
+            levels.push(Level {
+                matrix: current.take(),
+                inverse_diagonal,
+                lambda_max,
+                prolongator,
+                numbering,
+                transpose,
+            });
+            current = Some(coarse);
+            null_space = coarse_null;
+            blocks = coarse_blocks;
+        }
+        let coarse_matrix = current.unwrap_or_else(|| matrix.clone());
+        let (col_ptr, row_idx, values) = lower_triangle(&coarse_matrix);
+        let coarse_groups: Vec<usize> = (0..blocks.len() - 1)
+            .flat_map(|b| std::iter::repeat_n(b, blocks[b + 1] - blocks[b]))
+            .collect();
+        let mut coarse =
+            SparseCholesky::analyze(coarse_matrix.n, &col_ptr, &row_idx, Some(&coarse_groups))
+                .map_err(|e| MultigridError::Coarse(e.to_string()))?;
+        coarse
+            .factorize(&values)
+            .map_err(|e| MultigridError::Coarse(e.to_string()))?;
+        Ok(SmoothedAggregation {
+            levels,
+            coarse,
+            sizes,
+        })
+    }
+
+    /// One V-cycle from a zero guess for `A x = b` on `level` (`fine` is the finest matrix).
+    fn cycle(&mut self, level: usize, fine: &SymmetricCsr, b: &[Real], x: &mut [Real]) {
+        if level == self.levels.len() {
+            x.copy_from_slice(b);
+            self.coarse.solve_in_place(x);
+            return;
+        }
+        x.iter_mut().for_each(|v| *v = 0.0);
+        let mut r = b.to_vec();
+        let mut coarse_b;
+        let mut coarse_x;
+        {
+            let lv = &self.levels[level];
+            let a = lv.matrix.as_ref().unwrap_or(fine);
+            chebyshev(a, &lv.inverse_diagonal, lv.lambda_max, b, x, &mut r, true);
+            a.multiply(x, &mut r);
+            r.par_iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
+            coarse_b = vec![
+                0.0;
+                lv.numbering.offset.last().map_or(0, |o| *o)
+                    + lv.numbering.rank.last().map_or(0, |r| *r)
+            ];
+            lv.restrict(&r, &mut coarse_b);
+            coarse_x = vec![0.0; coarse_b.len()];
+        }
+        self.cycle(level + 1, fine, &coarse_b, &mut coarse_x);
+        let lv = &self.levels[level];
+        let a = lv.matrix.as_ref().unwrap_or(fine);
+        lv.prolong_add(&coarse_x, x);
+        chebyshev(a, &lv.inverse_diagonal, lv.lambda_max, b, x, &mut r, false);
+    }
+}
+
+/// Chebyshev smoothing of `A x = b` with the Jacobi-scaled polynomial on
+/// `[λmax / RATIO, 1.1 λmax]`. When `zero_start`, x is zero and `r` already holds b.
+fn chebyshev(
+    a: &SymmetricCsr,
+    inverse_diagonal: &[Real],
+    lambda_max: Real,
+    b: &[Real],
+    x: &mut [Real],
+    r: &mut [Real],
+    zero_start: bool,
+) {
+    let upper = 1.1 * lambda_max;
+    let lower = lambda_max / SMOOTHER_RATIO;
+    let theta = 0.5 * (upper + lower);
+    let delta = 0.5 * (upper - lower);
+    let sigma = theta / delta;
+    let mut rho = 1.0 / sigma;
+    if zero_start {
+        r.copy_from_slice(b);
+    } else {
+        a.multiply(x, r);
+        r.par_iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
+    }
+    let mut d: Vec<Real> = r
+        .iter()
+        .zip(inverse_diagonal)
+        .map(|(ri, di)| ri * di / theta)
+        .collect();
+    let mut ad = vec![0.0; d.len()];
+    for k in 0..SMOOTHER_DEGREE {
+        x.par_iter_mut().zip(&d).for_each(|(xi, di)| *xi += di);
+        if k + 1 == SMOOTHER_DEGREE {
+            break;
+        }
+        a.multiply(&d, &mut ad);
+        r.par_iter_mut().zip(&ad).for_each(|(ri, adi)| *ri -= adi);
+        let rho_next = 1.0 / (2.0 * sigma - rho);
+        let (c1, c2) = (rho_next * rho, 2.0 * rho_next / delta);
+        d.par_iter_mut()
+            .zip(r.par_iter().zip(inverse_diagonal))
+            .for_each(|(di, (ri, inv))| *di = c1 * *di + c2 * inv * ri);
+        rho = rho_next;
+    }
+}
+
+/// λmax of `D⁻¹A` by 15 Lanczos steps on the similar symmetric `D^-½ A D^-½`: Lanczos finds
+/// the extreme eigenvalue far faster than power iteration, and an estimate that is too low
+/// would let the Chebyshev smoother amplify the highest modes.
+fn largest_eigenvalue(a: &SymmetricCsr, inverse_diagonal: &[Real]) -> Real {
+    let n = a.n;
+    let scale: Vec<Real> = inverse_diagonal.iter().map(|d| d.sqrt()).collect();
+    let mut v: Vec<Real> = (0..n)
+        .map(|i| 1.0 + ((i * 7919) % 17) as Real / 17.0)
+        .collect();
+    let norm = dot(&v, &v).sqrt();
+    v.iter_mut().for_each(|x| *x /= norm);
+    let mut previous = vec![0.0; n];
+    let mut scaled = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    let (mut alphas, mut betas) = (Vec::new(), Vec::new());
+    let mut beta = 0.0;
+    for _ in 0..15.min(n) {
+        scaled
+            .par_iter_mut()
+            .zip(&v)
+            .zip(&scale)
+            .for_each(|((s, x), d)| *s = x * d);
+        a.multiply(&scaled, &mut w);
+        w.par_iter_mut().zip(&scale).for_each(|(x, d)| *x *= d);
+        let alpha = dot(&w, &v);
+        w.par_iter_mut()
+            .zip(v.par_iter().zip(&previous))
+            .for_each(|(x, (vi, pi))| *x -= alpha * vi + beta * pi);
+        alphas.push(alpha);
+        beta = dot(&w, &w).sqrt();
+        if beta <= 1e-12 * alpha.abs() {
+            break;
+        }
+        betas.push(beta);
+        std::mem::swap(&mut previous, &mut v);
+        v.par_iter_mut().zip(&w).for_each(|(x, y)| *x = y / beta);
+    }
+    let k = alphas.len();
+    let t = nalgebra::DMatrix::from_fn(k, k, |i, j| {
+        if i == j {
+            alphas[i]
+        } else if i + 1 == j || j + 1 == i {
+            betas[i.min(j)]
+        } else {
+            0.0
+        }
+    });
+    let lambda = t.symmetric_eigenvalues().max();
+    lambda.max(Real::MIN_POSITIVE)
+}
+
+/// Greedy aggregation of blocks (nodes, or the previous level's aggregates) on the block
+/// graph of `a`: first, a block whose neighbours are all free takes them all; then left-over
+/// blocks join a neighbouring aggregate; the rest group with their free neighbours.
+fn aggregate(a: &SymmetricCsr, blocks: &[usize]) -> Vec<u32> {
+    let count = blocks.len() - 1;
+    let mut block_of = vec![0u32; a.n];
+    for b in 0..count {
+        block_of[blocks[b]..blocks[b + 1]]
+            .iter_mut()
+            .for_each(|x| *x = b as u32);
+    }
+    // The pattern holds whole blocks, so the first row of a block meets every neighbouring
+    // block, in ascending order.
+    let neighbours: Vec<Vec<u32>> = (0..count)
+        .into_par_iter()
+        .map(|b| {
+            let r = blocks[b];
+            let mut list: Vec<u32> = Vec::new();
+            for &c in &a.col[a.row_ptr[r]..a.row_ptr[r + 1]] {
+                let nb = block_of[c as usize];
+                if nb as usize != b && list.last() != Some(&nb) {
+                    list.push(nb);
+                }
+            }
+            list
+        })
+        .collect();
+    const FREE: u32 = u32::MAX;
+    let mut agg = vec![FREE; count];
+    let mut next = 0u32;
+    for b in 0..count {
+        if agg[b] == FREE && neighbours[b].iter().all(|&nb| agg[nb as usize] == FREE) {
+            agg[b] = next;
+            for &nb in &neighbours[b] {
+                agg[nb as usize] = next;
+            }
+            next += 1;
+        }
+    }
+    let first_pass = agg.clone();
+    for b in 0..count {
+        if agg[b] == FREE {
+            if let Some(&nb) = neighbours[b]
+                .iter()
+                .find(|&&nb| first_pass[nb as usize] != FREE)
+            {
+                agg[b] = first_pass[nb as usize];
+            }
+        }
+    }
+    for b in 0..count {
+        if agg[b] == FREE {
+            agg[b] = next;
+            for &nb in &neighbours[b] {
+                if agg[nb as usize] == FREE {
+                    agg[nb as usize] = next;
+                }
+            }
+            next += 1;
+        }
+    }
+    agg
+}
+
+/// The tentative prolongator: on each aggregate, the near-null-space rows orthonormalised
+/// (modified Gram–Schmidt, dependent columns dropped). Returns it, the coarse numbering and
+/// the coarse near-null space (the R factors).
+fn tentative_prolongator(
+    blocks: &[usize],
+    aggregates: &[u32],
+    count: usize,
+    null_space: &[[Real; MODES]],
+) -> (AggregateRows, CoarseNumbering, Vec<[Real; MODES]>) {
+    let n = null_space.len();
+    let mut dofs_of: Vec<Vec<usize>> = vec![Vec::new(); count];
+    for (b, &g) in aggregates.iter().enumerate() {
+        dofs_of[g as usize].extend(blocks[b]..blocks[b + 1]);
+    }
+    // Per aggregate: Q as rows of MODES (zero-padded past the rank), R rows, rank.
+    type QAndR = (Vec<[Real; MODES]>, Vec<[Real; MODES]>);
+    let per_aggregate: Vec<QAndR> = dofs_of
+        .par_iter()
+        .map(|dofs| {
+            let mut q: Vec<Vec<Real>> = Vec::with_capacity(MODES);
+            let mut r: Vec<[Real; MODES]> = Vec::with_capacity(MODES);
+            let mut coefficients = [[0.0; MODES]; MODES];
+            for k in 0..MODES {
+                let mut v: Vec<Real> = dofs.iter().map(|&i| null_space[i][k]).collect();
+                let original = v.iter().map(|x| x * x).sum::<Real>().sqrt();
+                if original == 0.0 {
+                    continue;
+                }
+                for (j, qj) in q.iter().enumerate() {
+                    let c: Real = qj.iter().zip(&v).map(|(a, b)| a * b).sum();
+                    v.iter_mut().zip(qj).for_each(|(x, y)| *x -= c * y);
+                    coefficients[j][k] = c;
+                }
+                let norm = v.iter().map(|x| x * x).sum::<Real>().sqrt();
+                if norm > 1e-10 * original && q.len() < dofs.len() {
+                    v.iter_mut().for_each(|x| *x /= norm);
+                    coefficients[q.len()][k] = norm;
+                    q.push(v);
+                }
+            }
+            r.extend_from_slice(&coefficients[..q.len()]);
+            let q_rows = (0..dofs.len())
+                .map(|i| {
+                    let mut row = [0.0; MODES];
+                    for (j, col) in q.iter().enumerate() {
+                        row[j] = col[i];
+                    }
+                    row
+                })
+                .collect();
+            (q_rows, r)
+        })
+        .collect();
+    let mut numbering = CoarseNumbering {
+        offset: Vec::with_capacity(count),
+        rank: Vec::with_capacity(count),
+    };
+    let mut next = 0;
+    for (_, r) in &per_aggregate {
+        numbering.offset.push(next);
+        numbering.rank.push(r.len());
+        next += r.len();
+    }
+    let mut p = AggregateRows {
+        row_ptr: (0..=n).collect(),
+        aggregate: vec![0; n],
+        value: vec![[0.0; MODES]; n],
+    };
+    for (g, dofs) in dofs_of.iter().enumerate() {
+        for (local, &i) in dofs.iter().enumerate() {
+            p.aggregate[i] = g as u32;
+            p.value[i] = per_aggregate[g].0[local];
+        }
+    }
+    let coarse_null = per_aggregate.into_iter().flat_map(|(_, r)| r).collect();
+    (p, numbering, coarse_null)
+}
+
+/// `P = (I − ω D⁻¹ A) P₀`, row by row.
+fn smooth_prolongator(
+    a: &SymmetricCsr,
+    inverse_diagonal: &[Real],
+    omega: Real,
+    tentative: &AggregateRows,
+    count: usize,
+) -> AggregateRows {
+    let chunks = (0..a.n.div_ceil(ROWS_PER_TASK))
+        .into_par_iter()
+        .map(|chunk| {
+            let mut acc = RowAccumulator::new(count);
+            let mut out = (Vec::new(), Vec::new(), Vec::new());
+            let rows = chunk * ROWS_PER_TASK..((chunk + 1) * ROWS_PER_TASK).min(a.n);
+            for (i, inverse) in rows.clone().zip(&inverse_diagonal[rows]) {
+                for k in tentative.row_ptr[i]..tentative.row_ptr[i + 1] {
+                    acc.add(tentative.aggregate[k], 1.0, &tentative.value[k]);
+                }
+                let scale = -omega * inverse;
+                for e in a.row_ptr[i]..a.row_ptr[i + 1] {
+                    let j = a.col[e] as usize;
+                    for k in tentative.row_ptr[j]..tentative.row_ptr[j + 1] {
+                        acc.add(
+                            tentative.aggregate[k],
+                            scale * a.val[e],
+                            &tentative.value[k],
+                        );
+                    }
+                }
+                acc.finish(&mut out);
+            }
+            out
+        })
+        .collect();
+    concatenate(chunks)
+}
+
+/// The Galerkin coarse matrix `PᵀAP`, as full rows.
+fn galerkin(
+    a: &SymmetricCsr,
+    p: &AggregateRows,
+    transpose: &(Vec<usize>, Vec<(u32, u32)>),
+    numbering: &CoarseNumbering,
+) -> SymmetricCsr {
+    let count = numbering.rank.len();
+    // AP row by row, per aggregate.
+    let chunks = (0..a.n.div_ceil(ROWS_PER_TASK))
+        .into_par_iter()
+        .map(|chunk| {
+            let mut acc = RowAccumulator::new(count);
+            let mut out = (Vec::new(), Vec::new(), Vec::new());
+            for i in chunk * ROWS_PER_TASK..((chunk + 1) * ROWS_PER_TASK).min(a.n) {
+                for e in a.row_ptr[i]..a.row_ptr[i + 1] {
+                    let j = a.col[e] as usize;
+                    for k in p.row_ptr[j]..p.row_ptr[j + 1] {
+                        acc.add(p.aggregate[k], a.val[e], &p.value[k]);
+                    }
+                }
+                acc.finish(&mut out);
+            }
+            out
+        })
+        .collect();
+    let ap = concatenate(chunks);
+    // Block row g of PᵀAP = Σ over fine rows i touching g of P[i, g]ᵀ · AP[i, :].
+    let (start, pairs) = transpose;
+    const GROUPS_PER_TASK: usize = 64;
+    let rows: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = (0..count.div_ceil(GROUPS_PER_TASK))
+        .into_par_iter()
+        .map(|chunk| {
+            let mut place = vec![u32::MAX; count];
+            let mut touched: Vec<u32> = Vec::new();
+            let mut blocks: Vec<[[Real; MODES]; MODES]> = Vec::new();
+            let mut out = (Vec::new(), Vec::new(), Vec::new());
+            for g in chunk * GROUPS_PER_TASK..((chunk + 1) * GROUPS_PER_TASK).min(count) {
+                for &(i, e) in &pairs[start[g]..start[g + 1]] {
+                    let pv = &p.value[e as usize];
+                    let i = i as usize;
+                    for f in ap.row_ptr[i]..ap.row_ptr[i + 1] {
+                        let h = ap.aggregate[f];
+                        let slot = &mut place[h as usize];
+                        if *slot == u32::MAX {
+                            *slot = touched.len() as u32;
+                            touched.push(h);
+                            blocks.push([[0.0; MODES]; MODES]);
+                        }
+                        let block = &mut blocks[*slot as usize];
+                        let av = &ap.value[f];
+                        for (row, &pt) in block.iter_mut().zip(pv) {
+                            for (x, &y) in row.iter_mut().zip(av) {
+                                *x += pt * y;
+                            }
+                        }
+                    }
+                }
+                let mut order: Vec<usize> = (0..touched.len()).collect();
+                order.sort_unstable_by_key(|&k| touched[k]);
+                // t is the row inside every block of this block row, not an index into `blocks`.
+                #[allow(clippy::needless_range_loop)]
+                for t in 0..numbering.rank[g] {
+                    let mut length = 0;
+                    for &k in &order {
+                        let h = touched[k] as usize;
+                        let rank = numbering.rank[h];
+                        let first = numbering.offset[h] as u32;
+                        out.1.extend(first..first + rank as u32);
+                        out.2.extend_from_slice(&blocks[k][t][..rank]);
+                        length += rank;
+                    }
+                    out.0.push(length);
+                }
+                for &h in &touched {
+                    place[h as usize] = u32::MAX;
+                }
+                touched.clear();
+                blocks.clear();
+            }
+            out
+        })
+        .collect();
+    drop(ap);
+    let n: usize = numbering.rank.iter().sum();
+    let nnz: usize = rows.iter().map(|c| c.1.len()).sum();
+    let mut row_ptr = Vec::with_capacity(n + 1);
+    row_ptr.push(0);
+    let mut col = Vec::with_capacity(nnz);
+    let mut val = Vec::with_capacity(nnz);
+    for (lengths, c, v) in rows {
+        for l in lengths {
+            row_ptr.push(row_ptr[row_ptr.len() - 1] + l);
+        }
+        col.extend(c);
+        val.extend(v);
+    }
+    SymmetricCsr::from_rows(n, row_ptr, col, val)
+}
+
+/// The lower triangle of a symmetric full-row matrix in compressed columns (column c holds
+/// the row-c entries with column ≥ c).
+fn lower_triangle(a: &SymmetricCsr) -> (Vec<usize>, Vec<usize>, Vec<Real>) {
+    let mut col_ptr = vec![0usize];
+    let mut row_idx = Vec::new();
+    let mut values = Vec::new();
+    for r in 0..a.n {
+        for k in a.row_ptr[r]..a.row_ptr[r + 1] {
+            let c = a.col[k] as usize;
+            if c >= r {
+                row_idx.push(c);
+                values.push(a.val[k]);
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    (col_ptr, row_idx, values)
+}
+
+impl Preconditioner for SmoothedAggregation {
+    /// `z = M⁻¹ r`: one V-cycle from a zero guess.
+    fn apply(&mut self, fine: &SymmetricCsr, r: &[Real], z: &mut [Real]) {
+        self.cycle(0, fine, r, z);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linkage::{
+        conjugate_gradient, generators, member_block, BlockJacobi, Body, CgSettings, DofMap,
+        Material, StiffnessAssembly, Support,
+    };
+
+    /// A lattice with its bottom face fixed: full-row K_ff, groups, directions and the body.
+    fn lattice(
+        cells: [usize; 3],
+    ) -> (SymmetricCsr, StiffnessAssembly, Vec<Real>, Vec<usize>, Body) {
+        let size = [
+            cells[0] as Real * 0.01,
+            cells[1] as Real * 0.01,
+            cells[2] as Real * 0.01,
+        ];
+        let g = generators::box_lattice(size, cells).unwrap();
+        let mut body = Body::from_geometry("l", g, Material::new("s", 200e9, 1e-6));
+        for i in 0..body.nodes.len() {
+            if body.nodes[i].z == 0.0 {
+                body.supports.push(Support::fixed(i, [true, true, true]));
+            }
+        }
+        let dofs = DofMap::new(&body);
+        let asm = StiffnessAssembly::new(&body, &dofs).unwrap();
+        let mut values = Vec::new();
+        asm.fill(
+            &body,
+            |m| {
+                let [a, b] = body.members[m].nodes;
+                member_block(
+                    &body.nodes[a],
+                    &body.nodes[b],
+                    200e9 * 1e-6 / body.member_length(m),
+                )
+            },
+            &mut values,
+        );
+        let mut csr = SymmetricCsr::from_lower(asm.n, &asm.col_ptr, &asm.row_idx);
+        csr.refill(&values);
+        let directions = dofs.free.iter().map(|d| d % 3).collect();
+        (csr, asm, values, directions, body)
+    }
+
+    #[test]
+    fn multigrid_cg_matches_the_direct_solve_in_far_fewer_iterations() {
+        let (csr, asm, values, directions, body) = lattice([8, 8, 10]);
+        let b: Vec<Real> = (0..asm.n)
+            .map(|i| ((i * 7919) % 13) as Real - 6.0)
+            .collect();
+        let mut direct = b.clone();
+        let mut chol =
+            SparseCholesky::analyze(asm.n, &asm.col_ptr, &asm.row_idx, Some(&asm.groups)).unwrap();
+        chol.factorize(&values).unwrap();
+        chol.solve_in_place(&mut direct);
+
+        // Three levels at least: a small coarse size forces recursion.
+        let mut amg = SmoothedAggregation::with_coarse_size(
+            &csr,
+            &asm.groups,
+            &directions,
+            &body.nodes,
+            3,
+            200,
+        )
+        .unwrap();
+        assert!(amg.sizes.len() >= 3, "{:?}", amg.sizes);
+        let mut x = vec![0.0; asm.n];
+        let report = conjugate_gradient(&csr, &mut amg, &b, &mut x, CgSettings::default());
+        assert!(report.converged && report.residual <= 1e-10, "{report:?}");
+        let scale = direct.iter().map(|v| v.abs()).fold(0.0, Real::max);
+        let err = x
+            .iter()
+            .zip(&direct)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, Real::max);
+        assert!(err <= 1e-8 * scale, "{err:e} of {scale:e}");
+
+        let mut jacobi = BlockJacobi::new(&csr, &asm.groups).unwrap();
+        let mut y = vec![0.0; asm.n];
+        let plain = conjugate_gradient(&csr, &mut jacobi, &b, &mut y, CgSettings::default());
+        assert!(
+            report.iterations * 4 < plain.iterations,
+            "multigrid {} vs block-Jacobi {} iterations",
+            report.iterations,
+            plain.iterations
+        );
+    }
+}

@@ -1,0 +1,33 @@
+//! Pictures of stored results: PNG frames and a GIF of a run, 2D line art and shaded 3D patches.
+
+pub use self::bench::{bent_shell, render_benchmark, RenderTiming};
+pub use self::camera::{Camera, View, FIELD_OF_VIEW};
+pub use self::colour_scale::{colour_at, format_si, ColourScale, Rgb};
+pub use self::error::RenderError;
+pub use self::extent::{auto_magnification, RunExtent};
+pub use self::frame::Frame;
+pub use self::gif::GifAnimation;
+pub use self::options::{Colouring, Projection, RenderOptions, StepSelection};
+pub use self::picture::{camera_for, draw_frame, view_for, viewport_for};
+pub use self::primitives::{paint, Layer, Mesh, Primitive};
+pub use self::raster::{Lighting, RasterVertex, Rasteriser};
+pub use self::run_pictures::{render_run, select_steps, PictureWriter, RenderReport};
+
+mod bench;
+mod camera;
+mod colour_scale;
+mod deformed_body;
+mod draw2d;
+mod draw3d;
+mod error;
+mod extent;
+mod frame;
+mod gif;
+mod markers;
+mod options;
+mod overlay;
+mod picture;
+mod primitives;
+mod raster;
+mod run_pictures;
+mod text;

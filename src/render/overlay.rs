@@ -1,0 +1,307 @@
+use crate::render::colour_scale::{colour_at, format_si, si_unit, BLACK, FORCE_BLUE, INK};
+use crate::render::text::{draw_text, text_width};
+use crate::render::{Frame, Rgb};
+use crate::Real;
+use tiny_skia::{FillRule, LineCap, Paint, PathBuilder, Rect, Stroke, Transform};
+
+/// Where things go on a frame: the drawing's viewport and the size of the furniture.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layout {
+    /// Scale of text and marks: 1 at 720 pixels of frame height.
+    pub ui: f32,
+    /// The rectangle the model is fitted into: [x0, y0, x1, y1], pixels.
+    pub viewport: [Real; 4],
+    /// Whether a colour bar is drawn on the right.
+    pub colour_bar: bool,
+}
+
+/// Scale of text, marks and line widths on a `width` × `height` frame: 1 at 1280 × 720,
+/// never below 0.7 so that text stays readable on small frames.
+pub fn ui_scale(width: u32, height: u32) -> f32 {
+    (height.min(width.saturating_mul(9) / 16) as f32 / 720.0).max(0.7)
+}
+
+impl Layout {
+    /// The layout of a `width` × `height` frame, with or without a colour bar.
+    pub fn new(width: u32, height: u32, colour_bar: bool) -> Self {
+        let ui = ui_scale(width, height);
+        let (w, h) = (width as Real, height as Real);
+        let u = ui as Real;
+        let right = if colour_bar { 220.0 * u } else { 40.0 * u };
+        let mut viewport = [40.0 * u, 100.0 * u, w - right, h - 60.0 * u];
+        // A frame too small for the furniture: the drawing gets the whole frame.
+        if viewport[2] - viewport[0] < 0.2 * w || viewport[3] - viewport[1] < 0.2 * h {
+            viewport = [0.0, 0.0, w, h];
+        }
+        Layout {
+            ui,
+            viewport,
+            colour_bar,
+        }
+    }
+}
+
+/// The text and scales around the drawing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Caption {
+    /// Scene name.
+    pub scene: String,
+    /// Step drawn.
+    pub step: usize,
+    /// Last stored step.
+    pub last_step: usize,
+    /// Load factor of the step.
+    pub load_factor: Real,
+    /// Largest displacement at this step, m.
+    pub max_displacement: Real,
+    /// Overloaded members at this step.
+    pub overloaded: usize,
+    /// Displacement magnification.
+    pub magnification: Real,
+    /// Colour bar: (title, limit in Pa) when colouring by stress.
+    pub stress_bar: Option<(String, Real)>,
+    /// Largest applied force over the run, N (0: no force legend).
+    pub max_force: Real,
+}
+
+fn fmt_number(v: Real) -> String {
+    let s = if (v == v.round() && v.abs() < 1e6) || v.abs() >= 100.0 {
+        format!("{v:.0}")
+    } else if v.abs() >= 10.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    };
+    s.replace('-', "−")
+}
+
+/// Draw the caption (scene, step, load factor), the magnification, the stress colour bar
+/// and the legend onto `frame`.
+pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
+    let ui = layout.ui;
+    let (w, h) = (frame.width() as f32, frame.height() as f32);
+    let big = 26.0 * ui;
+    let small = 17.0 * ui;
+    let x = 40.0 * ui;
+    let title = format!(
+        "{}  ·  step {} of {}  ·  load factor {}",
+        c.scene,
+        c.step,
+        c.last_step,
+        fmt_load(c.load_factor)
+    );
+    draw_text(&mut frame.pixmap, &title, x, 46.0 * ui, big, INK);
+    let mut sub = format!("max |u| = {}", format_si(c.max_displacement, "m"));
+    sub.push_str(&format!(
+        "  ·  {} overloaded member{}",
+        c.overloaded,
+        if c.overloaded == 1 { "" } else { "s" }
+    ));
+    draw_text(
+        &mut frame.pixmap,
+        &sub,
+        x,
+        76.0 * ui,
+        small,
+        Rgb(0.35, 0.35, 0.38),
+    );
+    let mag = if (c.magnification - 1.0).abs() < 1e-12 {
+        "displacements to scale (×1)".to_string()
+    } else {
+        format!(
+            "displacements drawn ×{}",
+            fmt_magnification(c.magnification)
+        )
+    };
+    draw_text(&mut frame.pixmap, &mag, x, h - 24.0 * ui, small, INK);
+
+    if let Some((bar_title, limit)) = &c.stress_bar {
+        let x0 = w - 200.0 * ui;
+        let bw = 22.0 * ui;
+        let top = 130.0 * ui;
+        let bottom = (h - 220.0 * ui).max(top + 60.0 * ui);
+        let (div, unit) = si_unit(*limit, "Pa");
+        draw_text(
+            &mut frame.pixmap,
+            bar_title,
+            x0 - 10.0 * ui,
+            top - 34.0 * ui,
+            small,
+            INK,
+        );
+        draw_text(
+            &mut frame.pixmap,
+            &format!("({unit})"),
+            x0 - 10.0 * ui,
+            top - 14.0 * ui,
+            small * 0.9,
+            Rgb(0.35, 0.35, 0.38),
+        );
+        let rows = (bottom - top).ceil() as usize;
+        for r in 0..rows {
+            let t = 1.0 - r as f32 / (rows - 1).max(1) as f32;
+            let mut paint = Paint::default();
+            paint.set_color(colour_at(t).with_alpha(1.0));
+            if let Some(rect) = Rect::from_xywh(x0, top + r as f32, bw, 1.0) {
+                frame
+                    .pixmap
+                    .fill_rect(rect, &paint, Transform::identity(), None);
+            }
+        }
+        let mut ink = Paint::default();
+        ink.set_color(INK.with_alpha(1.0));
+        ink.anti_alias = true;
+        let mut pb = PathBuilder::new();
+        if let Some(rect) = Rect::from_xywh(x0, top, bw, bottom - top) {
+            pb.push_rect(rect);
+        }
+        for k in 0..5 {
+            let y = top + (bottom - top) * k as f32 / 4.0;
+            pb.move_to(x0 + bw, y);
+            pb.line_to(x0 + bw + 6.0 * ui, y);
+            let v = limit * (1.0 - k as Real / 2.0) / div;
+            let label = if k == 2 {
+                "0".to_string()
+            } else if v > 0.0 {
+                format!("+{}", fmt_number(v))
+            } else {
+                fmt_number(v)
+            };
+            draw_text(
+                &mut frame.pixmap,
+                &label,
+                x0 + bw + 10.0 * ui,
+                y + 6.0 * ui,
+                small,
+                INK,
+            );
+        }
+        if let Some(path) = pb.finish() {
+            let s = Stroke {
+                width: 1.0 * ui,
+                ..Stroke::default()
+            };
+            frame
+                .pixmap
+                .stroke_path(&path, &ink, &s, Transform::identity(), None);
+        }
+        let note = small * 0.85;
+        let grey = Rgb(0.35, 0.35, 0.38);
+        draw_text(
+            &mut frame.pixmap,
+            "tension",
+            x0 + bw + 10.0 * ui + text_width("+0.00", small) + 8.0 * ui,
+            top + 6.0 * ui,
+            note,
+            grey,
+        );
+        draw_text(
+            &mut frame.pixmap,
+            "compression",
+            x0 - 10.0 * ui,
+            bottom + 24.0 * ui,
+            note,
+            grey,
+        );
+
+        // Legend.
+        let ly = bottom + 62.0 * ui;
+        let mut black = Paint::default();
+        black.set_color(BLACK.with_alpha(1.0));
+        black.anti_alias = true;
+        let mut pb = PathBuilder::new();
+        pb.move_to(x0, ly);
+        pb.line_to(x0 + 34.0 * ui, ly);
+        if let Some(path) = pb.finish() {
+            let s = Stroke {
+                width: 5.0 * ui,
+                line_cap: LineCap::Round,
+                ..Stroke::default()
+            };
+            frame
+                .pixmap
+                .stroke_path(&path, &black, &s, Transform::identity(), None);
+        }
+        draw_text(
+            &mut frame.pixmap,
+            "overloaded",
+            x0 + 44.0 * ui,
+            ly + 6.0 * ui,
+            small,
+            INK,
+        );
+        if c.max_force > 0.0 {
+            legend_arrow(frame, x0, ly + 34.0 * ui, ui);
+            draw_text(
+                &mut frame.pixmap,
+                "applied force",
+                x0 + 44.0 * ui,
+                ly + 40.0 * ui,
+                small,
+                INK,
+            );
+            draw_text(
+                &mut frame.pixmap,
+                &format!("(largest {})", format_si(c.max_force, "N")),
+                x0 + 44.0 * ui,
+                ly + 62.0 * ui,
+                small * 0.85,
+                Rgb(0.35, 0.35, 0.38),
+            );
+        }
+    }
+}
+
+fn legend_arrow(frame: &mut Frame, x: f32, y: f32, ui: f32) {
+    let mut paint = Paint::default();
+    paint.set_color(FORCE_BLUE.with_alpha(1.0));
+    paint.anti_alias = true;
+    let mut pb = PathBuilder::new();
+    pb.move_to(x, y);
+    pb.line_to(x + 22.0 * ui, y);
+    if let Some(path) = pb.finish() {
+        let s = Stroke {
+            width: 3.0 * ui,
+            line_cap: LineCap::Round,
+            ..Stroke::default()
+        };
+        frame
+            .pixmap
+            .stroke_path(&path, &paint, &s, Transform::identity(), None);
+    }
+    let mut pb = PathBuilder::new();
+    pb.move_to(x + 34.0 * ui, y);
+    pb.line_to(x + 21.0 * ui, y - 5.5 * ui);
+    pb.line_to(x + 21.0 * ui, y + 5.5 * ui);
+    pb.close();
+    if let Some(path) = pb.finish() {
+        frame.pixmap.fill_path(
+            &path,
+            &paint,
+            FillRule::Winding,
+            Transform::identity(),
+            None,
+        );
+    }
+}
+
+fn fmt_load(f: Real) -> String {
+    let s = format!("{f:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s.is_empty() || s == "-" {
+        "0".to_string()
+    } else {
+        s.replace('-', "−")
+    }
+}
+
+fn fmt_magnification(m: Real) -> String {
+    if m >= 1.0 && m == m.round() {
+        format!("{m:.0}")
+    } else {
+        format!("{m:.3}")
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    }
+}

@@ -1,0 +1,186 @@
+//! `model.json`: the undeformed model of a run (what the step files do not repeat), written
+//! once per run so results can be drawn and exported again without the scene file.
+
+use crate::scene::results::StepResult;
+use crate::scene::World;
+use crate::Real;
+use serde::{Deserialize, Serialize};
+
+/// The directions a support holds at one node (several supports of a node combined).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SupportedNode {
+    /// 1-based node number.
+    pub node: usize,
+    /// Held directions: any of `"x"`, `"y"`, `"z"`, in that order.
+    pub fix: Vec<String>,
+}
+
+/// One body of `model.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelBody {
+    /// Body name (as in the step files).
+    pub name: String,
+    /// 2 or 3.
+    pub dimension: usize,
+    /// Undeformed node positions, m, one `[x, y]` or `[x, y, z]` per node.
+    pub nodes: Vec<Vec<Real>>,
+    /// Members as 1-based node pairs, in member order.
+    pub members: Vec<[usize; 2]>,
+    /// Outward surface triangles as 1-based node triples (3D; may be empty).
+    pub patches: Vec<[usize; 3]>,
+    /// Supported nodes, by node number.
+    pub supports: Vec<SupportedNode>,
+}
+
+/// `model.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelFile {
+    /// Scene name.
+    pub scene: String,
+    /// Every body, in scene order (the order of the step files).
+    pub bodies: Vec<ModelBody>,
+}
+
+impl ModelFile {
+    /// The undeformed model of `world`.
+    pub fn new(world: &World) -> Self {
+        let bodies = world
+            .bodies
+            .iter()
+            .map(|b| {
+                let d = b.dimension.dofs_per_node();
+                let mut fixed = vec![[false; 3]; b.nodes.len()];
+                for s in &b.supports {
+                    if let Some(f) = fixed.get_mut(s.node) {
+                        for (k, held) in s.fixed.iter().enumerate().take(d) {
+                            f[k] |= *held;
+                        }
+                    }
+                }
+                let supports = fixed
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, f)| f.iter().any(|h| *h))
+                    .map(|(n, f)| SupportedNode {
+                        node: n + 1,
+                        fix: ["x", "y", "z"]
+                            .iter()
+                            .zip(f)
+                            .filter(|(_, h)| **h)
+                            .map(|(name, _)| name.to_string())
+                            .collect(),
+                    })
+                    .collect();
+                ModelBody {
+                    name: b.name.clone(),
+                    dimension: d,
+                    nodes: b.nodes.iter().map(|p| p.as_slice()[..d].to_vec()).collect(),
+                    members: b
+                        .members
+                        .iter()
+                        .map(|m| [m.nodes[0] + 1, m.nodes[1] + 1])
+                        .collect(),
+                    patches: b.patches.iter().map(|p| p.map(|n| n + 1)).collect(),
+                    supports,
+                }
+            })
+            .collect();
+        ModelFile {
+            scene: world.name.clone(),
+            bodies,
+        }
+    }
+
+    /// Whether every number in the file refers to something that exists (a torn or edited
+    /// file is caught here rather than by an index out of range later). Returns the problem.
+    pub fn problem(&self) -> Option<String> {
+        for b in &self.bodies {
+            let n = b.nodes.len();
+            if b.dimension != 2 && b.dimension != 3 {
+                return Some(format!(
+                    "body '{}' has dimension {}: 2 or 3",
+                    b.name, b.dimension
+                ));
+            }
+            if let Some(p) = b.nodes.iter().position(|p| p.len() != b.dimension) {
+                return Some(format!(
+                    "body '{}': node {} has {} coordinates, not {}",
+                    b.name,
+                    p + 1,
+                    b.nodes[p].len(),
+                    b.dimension
+                ));
+            }
+            let bad = |k: usize| k == 0 || k > n;
+            if let Some(m) = b.members.iter().position(|m| m.iter().any(|&k| bad(k))) {
+                return Some(format!(
+                    "body '{}': member {} names a node outside 1..={n}",
+                    b.name,
+                    m + 1
+                ));
+            }
+            if let Some(p) = b.patches.iter().position(|p| p.iter().any(|&k| bad(k))) {
+                return Some(format!(
+                    "body '{}': patch {} names a node outside 1..={n}",
+                    b.name,
+                    p + 1
+                ));
+            }
+            if let Some(s) = b.supports.iter().find(|s| bad(s.node)) {
+                return Some(format!(
+                    "body '{}': support names node {} outside 1..={n}",
+                    b.name, s.node
+                ));
+            }
+        }
+        None
+    }
+
+    /// Whether `step` belongs to this model: the same bodies, one position and displacement
+    /// per node, one force and stress per member, and only existing nodes and members named.
+    /// Returns the problem.
+    pub fn step_problem(&self, step: &StepResult) -> Option<String> {
+        if step.bodies.len() != self.bodies.len() {
+            return Some(format!(
+                "has {} bodies but model.json has {}",
+                step.bodies.len(),
+                self.bodies.len()
+            ));
+        }
+        for (b, m) in step.bodies.iter().zip(&self.bodies) {
+            let n = m.nodes.len();
+            let per_node_ok =
+                |v: &[Vec<Real>]| v.len() == n && v.iter().all(|x| x.len() == m.dimension);
+            if b.name != m.name
+                || !per_node_ok(&b.positions)
+                || !per_node_ok(&b.displacements)
+                || b.axial_forces.len() != m.members.len()
+                || b.stresses.len() != m.members.len()
+            {
+                return Some(format!(
+                    "body '{}' does not match model.json (body '{}': {} nodes, {} members)",
+                    b.name,
+                    m.name,
+                    n,
+                    m.members.len()
+                ));
+            }
+            let node_ok = |k: usize| (1..=n).contains(&k);
+            let force_ok = |node: usize, f: &[Real]| node_ok(node) && f.len() == m.dimension;
+            if !b
+                .overloaded
+                .iter()
+                .all(|k| (1..=m.members.len()).contains(k))
+                || !b.loads.iter().all(|l| force_ok(l.node, &l.force))
+                || !b.reactions.iter().all(|l| force_ok(l.node, &l.force))
+                || !b.contacts.iter().all(|c| force_ok(c.node, &c.force))
+            {
+                return Some(format!(
+                    "body '{}' names a node or member that does not exist, or a force with the wrong number of components",
+                    b.name
+                ));
+            }
+        }
+        None
+    }
+}

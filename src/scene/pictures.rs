@@ -1,0 +1,91 @@
+//! What a run draws and exports besides its JSON results: `[output] png / gif / vtk` and the
+//! picture options of the scene file (the CLI's `--png` and `--vtk` switch them on too).
+
+use crate::scene::spec::OutputSpec;
+use crate::Real;
+
+/// Pictures and VTK files a run writes (see `docs/SCENES.md`, `[output]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PictureSettings {
+    /// Write `png/NNNN.png`, one frame per stored step.
+    pub png: bool,
+    /// Write `anim.gif`, one frame per stored step (default: as `png`).
+    pub gif: bool,
+    /// Write `vtk/NNNN.vtu` per stored step and `vtk/<scene>.pvd`.
+    pub vtk: bool,
+    /// Frame width, pixels.
+    pub width: u32,
+    /// Frame height, pixels.
+    pub height: u32,
+    /// Displacement magnification; `None`: automatic (1 unless displacements are tiny).
+    pub magnification: Option<Real>,
+    /// Camera azimuth, degrees (3D; `None`: the default view).
+    pub azimuth: Option<Real>,
+    /// Camera elevation, degrees (3D; `None`: the default view).
+    pub elevation: Option<Real>,
+}
+
+impl Default for PictureSettings {
+    fn default() -> Self {
+        PictureSettings {
+            png: false,
+            gif: false,
+            vtk: false,
+            width: 1280,
+            height: 720,
+            magnification: None,
+            azimuth: None,
+            elevation: None,
+        }
+    }
+}
+
+/// Largest frame side, pixels.
+pub const MAX_FRAME_SIDE: u32 = 8192;
+
+impl PictureSettings {
+    /// Switch on PNG frames and the GIF (the CLI's `--png`).
+    pub fn ask_png(&mut self) {
+        self.png = true;
+        self.gif = true;
+    }
+
+    /// Check the `[output]` picture keys; the error says what to give instead.
+    pub fn from_spec(spec: &OutputSpec) -> Result<Self, String> {
+        let d = PictureSettings::default();
+        let png = spec.png.unwrap_or(false);
+        let side = |key: &str, v: Option<u32>, default: u32| match v {
+            None => Ok(default),
+            Some(v) if (16..=MAX_FRAME_SIDE).contains(&v) => Ok(v),
+            Some(v) => Err(format!(
+                "[output] {key} = {v}: give a frame size from 16 to {MAX_FRAME_SIDE} pixels"
+            )),
+        };
+        if let Some(m) = spec.magnification {
+            if !(m.is_finite() && m > 0.0) {
+                return Err(format!(
+                    "[output] magnification = {m}: give a positive number (1 draws displacements to scale)"
+                ));
+            }
+        }
+        for (key, v) in [("azimuth", spec.azimuth), ("elevation", spec.elevation)] {
+            if let Some(a) = v {
+                if !a.is_finite() || (key == "elevation" && a.abs() > 90.0) {
+                    return Err(format!(
+                        "[output] {key} = {a}: give degrees (elevation from -90 to 90)"
+                    ));
+                }
+            }
+        }
+        Ok(PictureSettings {
+            png,
+            gif: spec.gif.unwrap_or(png),
+            vtk: spec.vtk.unwrap_or(false),
+            width: side("width", spec.width, d.width)?,
+            height: side("height", spec.height, d.height)?,
+            magnification: spec.magnification,
+            azimuth: spec.azimuth,
+            elevation: spec.elevation,
+        })
+    }
+}

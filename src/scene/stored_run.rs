@@ -1,0 +1,124 @@
+//! A results folder read back: `model.json` and the stored `steps/NNNN.json`, checked against
+//! each other, for drawing and exporting a run without solving it again.
+
+use crate::scene::model_file::ModelFile;
+use crate::scene::results::StepResult;
+use std::path::{Path, PathBuf};
+
+/// Why a results folder cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum StoredRunError {
+    /// The folder or one of its files is missing or unreadable.
+    #[error("{path}: cannot read: {source}; {hint}")]
+    Read {
+        /// File or folder.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+        /// What to do.
+        hint: &'static str,
+    },
+    /// A file that is not what `linkage run` writes (torn, edited or from another version).
+    #[error("{path}: {problem}; run the scene again with `linkage run`")]
+    Bad {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        problem: String,
+    },
+}
+
+const FOLDER_HINT: &str =
+    "give a folder written by `linkage run SCENE --out DIR` (DIR/<scene name>)";
+
+/// A complete results folder: the model and the numbers of its stored steps.
+#[derive(Clone, Debug)]
+pub struct StoredRun {
+    /// The folder, `DIR/<scene>`.
+    pub dir: PathBuf,
+    /// The undeformed model.
+    pub model: ModelFile,
+    /// Stored step numbers, ascending (step 0 first).
+    pub steps: Vec<usize>,
+}
+
+impl StoredRun {
+    /// Read `dir/model.json` and list `dir/steps/NNNN.json`.
+    pub fn open(dir: &Path) -> Result<Self, StoredRunError> {
+        let path = dir.join("model.json");
+        let bytes = std::fs::read(&path).map_err(|source| StoredRunError::Read {
+            hint: if dir.is_dir() {
+                "the folder was written by an older linkage or is not a results folder: run the scene again with `linkage run`"
+            } else {
+                FOLDER_HINT
+            },
+            path: path.clone(),
+            source,
+        })?;
+        let model: ModelFile = serde_json::from_slice(&bytes).map_err(|e| StoredRunError::Bad {
+            path: path.clone(),
+            problem: format!("not a model file ({e})"),
+        })?;
+        if let Some(problem) = model.problem() {
+            return Err(StoredRunError::Bad { path, problem });
+        }
+        let steps_dir = dir.join("steps");
+        let entries = std::fs::read_dir(&steps_dir).map_err(|source| StoredRunError::Read {
+            path: steps_dir.clone(),
+            source,
+            hint: FOLDER_HINT,
+        })?;
+        let mut steps = Vec::new();
+        for entry in entries {
+            let entry = entry.map_err(|source| StoredRunError::Read {
+                path: steps_dir.clone(),
+                source,
+                hint: FOLDER_HINT,
+            })?;
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if let Some(stem) = name.strip_suffix(".json") {
+                if stem.len() >= 4 && stem.bytes().all(|b| b.is_ascii_digit()) {
+                    if let Ok(k) = stem.parse::<usize>() {
+                        steps.push(k);
+                    }
+                }
+            }
+        }
+        steps.sort_unstable();
+        if steps.is_empty() {
+            return Err(StoredRunError::Bad {
+                path: steps_dir,
+                problem: "holds no step files (NNNN.json)".to_string(),
+            });
+        }
+        Ok(StoredRun {
+            dir: dir.to_path_buf(),
+            model,
+            steps,
+        })
+    }
+
+    /// The file of stored step `step`.
+    pub fn step_path(&self, step: usize) -> PathBuf {
+        self.dir.join("steps").join(format!("{step:04}.json"))
+    }
+
+    /// Read stored step `step` and check that it matches the model (bodies, nodes, members).
+    pub fn read_step(&self, step: usize) -> Result<StepResult, StoredRunError> {
+        let path = self.step_path(step);
+        let bytes = std::fs::read(&path).map_err(|source| StoredRunError::Read {
+            path: path.clone(),
+            source,
+            hint: "the folder is incomplete",
+        })?;
+        let result: StepResult =
+            serde_json::from_slice(&bytes).map_err(|e| StoredRunError::Bad {
+                path: path.clone(),
+                problem: format!("not a step file ({e})"),
+            })?;
+        if let Some(problem) = self.model.step_problem(&result) {
+            return Err(StoredRunError::Bad { path, problem });
+        }
+        Ok(result)
+    }
+}

@@ -1,0 +1,275 @@
+//! ParaView files of a stored run: `vtk/NNNN.vtu` per stored step (VTK XML unstructured grid,
+//! ASCII) and `vtk/<scene>.pvd`, the collection ParaView plays as the deformation process.
+//!
+//! One `.vtu` holds every body of the scene: points are the deformed node positions (z = 0
+//! for 2D bodies), body after body; cells are the members as lines (VTK_LINE = 3), in member
+//! order, body after body, then the patches as triangles (VTK_TRIANGLE = 5). Point data:
+//! `displacement`, `applied_force`, `reaction`, `contact_force` (3 components, m or N) and
+//! `body` (1-based). Cell data: `axial_force` (N), `stress` (Pa), `overloaded` (0/1),
+//! `member` (1-based, 0 on triangles) and `body`. A triangle carries the mean axial force and
+//! stress of those of its three edges that are members (0 if none) and `overloaded` = 0.
+
+use crate::atomic_file::write_atomically;
+use crate::scene::model_file::ModelBody;
+use crate::scene::results::{BodyResult, StepResult};
+use crate::scene::stored_run::{StoredRun, StoredRunError};
+use crate::Real;
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Why VTK files could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum VtkError {
+    /// A stored step could not be read.
+    #[error(transparent)]
+    Read(#[from] StoredRunError),
+    /// A file could not be written.
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        /// File or folder.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+/// Write `vtk/NNNN.vtu` for every stored step of `run` and `vtk/<scene>.pvd`. The
+/// collection's `timestep` is the load factor when it grows strictly over the stored steps,
+/// else the step number (ParaView needs increasing times). Returns the files written.
+pub fn write_vtk(run: &StoredRun) -> Result<Vec<PathBuf>, VtkError> {
+    let dir = run.dir.join("vtk");
+    std::fs::create_dir_all(&dir).map_err(|source| VtkError::Write {
+        path: dir.clone(),
+        source,
+    })?;
+    let mut written = Vec::new();
+    let mut entries = Vec::new();
+    for &step in &run.steps {
+        let result = run.read_step(step)?;
+        let name = format!("{step:04}.vtu");
+        let path = dir.join(&name);
+        write_atomically(&path, vtu_text(&run.model.bodies, &result).as_bytes()).map_err(
+            |source| VtkError::Write {
+                path: path.clone(),
+                source,
+            },
+        )?;
+        written.push(path);
+        entries.push((step, result.load_factor, name));
+    }
+    let increasing = entries.windows(2).all(|w| w[1].1 > w[0].1);
+    let mut pvd = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
+    );
+    for (step, factor, name) in &entries {
+        let time = if increasing { *factor } else { *step as Real };
+        let _ = writeln!(
+            pvd,
+            "    <DataSet timestep=\"{time}\" group=\"\" part=\"0\" file=\"{name}\"/>"
+        );
+    }
+    pvd.push_str("  </Collection>\n</VTKFile>\n");
+    let path = dir.join(format!("{}.pvd", run.model.scene));
+    write_atomically(&path, pvd.as_bytes()).map_err(|source| VtkError::Write {
+        path: path.clone(),
+        source,
+    })?;
+    written.push(path);
+    Ok(written)
+}
+
+/// One VTK cell: a member (line) or a patch (triangle) with its cell data.
+struct Cell {
+    points: Vec<usize>,
+    kind: u8,
+    axial_force: Real,
+    stress: Real,
+    overloaded: u8,
+    member: usize,
+    body: usize,
+}
+
+/// A per-node 3-vector array of one body from a list of (1-based node, force) entries.
+fn node_vectors<'a>(
+    n: usize,
+    entries: impl Iterator<Item = (usize, &'a Vec<Real>)>,
+) -> Vec<[Real; 3]> {
+    let mut v = vec![[0.0; 3]; n];
+    for (node, f) in entries {
+        if let Some(slot) = v.get_mut(node.wrapping_sub(1)) {
+            for (s, x) in slot.iter_mut().zip(f) {
+                *s += x;
+            }
+        }
+    }
+    v
+}
+
+fn padded(p: &[Real]) -> [Real; 3] {
+    [
+        p.first().copied().unwrap_or(0.0),
+        p.get(1).copied().unwrap_or(0.0),
+        p.get(2).copied().unwrap_or(0.0),
+    ]
+}
+
+/// The text of one `.vtu` file for `result` of a run with model `bodies`.
+pub(crate) fn vtu_text(bodies: &[ModelBody], result: &StepResult) -> String {
+    let mut points: Vec<[Real; 3]> = Vec::new();
+    let mut displacement = Vec::new();
+    let mut applied = Vec::new();
+    let mut reaction = Vec::new();
+    let mut contact = Vec::new();
+    let mut point_body = Vec::new();
+    let mut lines: Vec<Cell> = Vec::new();
+    let mut triangles = Vec::new();
+    for (k, (m, r)) in bodies.iter().zip(&result.bodies).enumerate() {
+        let base = points.len();
+        let n = m.nodes.len();
+        points.extend(r.positions.iter().map(|p| padded(p)));
+        displacement.extend(r.displacements.iter().map(|p| padded(p)));
+        applied.extend(node_vectors(n, r.loads.iter().map(|l| (l.node, &l.force))));
+        reaction.extend(node_vectors(
+            n,
+            r.reactions.iter().map(|l| (l.node, &l.force)),
+        ));
+        contact.extend(node_vectors(
+            n,
+            r.contacts.iter().map(|c| (c.node, &c.force)),
+        ));
+        point_body.extend(std::iter::repeat_n(k + 1, n));
+        let overloaded = overloaded_flags(m, r);
+        let mut member_of: HashMap<(usize, usize), usize> = HashMap::new();
+        for (j, e) in m.members.iter().enumerate() {
+            member_of.insert((e[0].min(e[1]), e[0].max(e[1])), j);
+            lines.push(Cell {
+                points: vec![base + e[0] - 1, base + e[1] - 1],
+                kind: 3,
+                axial_force: r.axial_forces[j],
+                stress: r.stresses[j],
+                overloaded: overloaded[j],
+                member: j + 1,
+                body: k + 1,
+            });
+        }
+        for p in &m.patches {
+            let edges = [(p[0], p[1]), (p[1], p[2]), (p[2], p[0])];
+            let members: Vec<usize> = edges
+                .iter()
+                .filter_map(|&(a, b)| member_of.get(&(a.min(b), a.max(b))).copied())
+                .collect();
+            let mean = |v: &[Real]| {
+                if members.is_empty() {
+                    0.0
+                } else {
+                    members.iter().map(|&j| v[j]).sum::<Real>() / members.len() as Real
+                }
+            };
+            triangles.push(Cell {
+                points: p.iter().map(|&i| base + i - 1).collect(),
+                kind: 5,
+                axial_force: mean(&r.axial_forces),
+                stress: mean(&r.stresses),
+                overloaded: 0,
+                member: 0,
+                body: k + 1,
+            });
+        }
+    }
+    lines.extend(triangles);
+    let cells = lines;
+
+    let mut s = String::with_capacity(64 * (points.len() + cells.len()) + 1024);
+    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n");
+    let _ = writeln!(
+        s,
+        "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
+        points.len(),
+        cells.len()
+    );
+    s.push_str("      <PointData Vectors=\"displacement\">\n");
+    vectors(&mut s, "displacement", &displacement);
+    vectors(&mut s, "applied_force", &applied);
+    vectors(&mut s, "reaction", &reaction);
+    vectors(&mut s, "contact_force", &contact);
+    ints(&mut s, "body", point_body.iter().copied());
+    s.push_str("      </PointData>\n      <CellData Scalars=\"stress\">\n");
+    scalars(&mut s, "axial_force", cells.iter().map(|c| c.axial_force));
+    scalars(&mut s, "stress", cells.iter().map(|c| c.stress));
+    ints(
+        &mut s,
+        "overloaded",
+        cells.iter().map(|c| c.overloaded as usize),
+    );
+    ints(&mut s, "member", cells.iter().map(|c| c.member));
+    ints(&mut s, "body", cells.iter().map(|c| c.body));
+    s.push_str("      </CellData>\n      <Points>\n");
+    vectors(&mut s, "Points", &points);
+    s.push_str("      </Points>\n      <Cells>\n");
+    array_open(&mut s, "Int64", "connectivity", 1);
+    for c in &cells {
+        for i in &c.points {
+            let _ = write!(s, "{i} ");
+        }
+    }
+    s.push_str("\n        </DataArray>\n");
+    array_open(&mut s, "Int64", "offsets", 1);
+    let mut offset = 0;
+    for c in &cells {
+        offset += c.points.len();
+        let _ = write!(s, "{offset} ");
+    }
+    s.push_str("\n        </DataArray>\n");
+    array_open(&mut s, "UInt8", "types", 1);
+    for c in &cells {
+        let _ = write!(s, "{} ", c.kind);
+    }
+    s.push_str(
+        "\n        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n",
+    );
+    s
+}
+
+fn overloaded_flags(m: &ModelBody, r: &BodyResult) -> Vec<u8> {
+    let mut f = vec![0u8; m.members.len()];
+    for &j in &r.overloaded {
+        if let Some(x) = f.get_mut(j.wrapping_sub(1)) {
+            *x = 1;
+        }
+    }
+    f
+}
+
+/// Scalars (1 component) leave `NumberOfComponents` out, so readers give plain arrays.
+fn array_open(s: &mut String, ty: &str, name: &str, components: usize) {
+    let _ = write!(s, "        <DataArray type=\"{ty}\" Name=\"{name}\" ");
+    if components > 1 {
+        let _ = write!(s, "NumberOfComponents=\"{components}\" ");
+    }
+    s.push_str("format=\"ascii\">\n          ");
+}
+
+fn vectors(s: &mut String, name: &str, v: &[[Real; 3]]) {
+    array_open(s, "Float64", name, 3);
+    for p in v {
+        let _ = write!(s, "{:e} {:e} {:e} ", p[0], p[1], p[2]);
+    }
+    s.push_str("\n        </DataArray>\n");
+}
+
+fn scalars(s: &mut String, name: &str, v: impl Iterator<Item = Real>) {
+    array_open(s, "Float64", name, 1);
+    for x in v {
+        let _ = write!(s, "{x:e} ");
+    }
+    s.push_str("\n        </DataArray>\n");
+}
+
+fn ints(s: &mut String, name: &str, v: impl Iterator<Item = usize>) {
+    array_open(s, "Int32", name, 1);
+    for x in v {
+        let _ = write!(s, "{x} ");
+    }
+    s.push_str("\n        </DataArray>\n");
+}

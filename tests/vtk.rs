@@ -1,0 +1,231 @@
+//! ParaView files read back by a real VTK reader (Python's meshio): geometry, cells and the
+//! arrays carry the values of the step files.
+//!
+//! meshio is installed on first use into a venv under `target/` (PyPI must be reachable);
+//! `.ci/run` installs it before the tests.
+
+use linkage::scene::{load_scene, run, StepResult};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A Python with meshio: `target/meshio-venv`, created and filled when missing.
+fn meshio_python() -> PathBuf {
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/meshio-venv");
+    let python = venv.join("bin/python");
+    let has_meshio = |py: &Path| {
+        Command::new(py)
+            .args(["-c", "import meshio"])
+            .output()
+            .map(|o| o.status.success())
+            .unwrap_or(false)
+    };
+    if has_meshio(&python) {
+        return python;
+    }
+    let made = Command::new("python3")
+        .args(["-m", "venv"])
+        .arg(&venv)
+        .output();
+    match made {
+        Ok(o) if o.status.success() => {}
+        Ok(o) => panic!(
+            "cannot create a Python venv at {} to read VTK files with meshio: {}\n\
+             install python3 with its venv module (Debian: apt-get install python3-venv)",
+            venv.display(),
+            String::from_utf8_lossy(&o.stderr)
+        ),
+        Err(e) => panic!(
+            "cannot run python3 ({e}) to read VTK files with meshio: install python3 (3.9 or later)"
+        ),
+    }
+    let pip = Command::new(&python)
+        .args(["-m", "pip", "install", "--quiet", "meshio"])
+        .output()
+        .expect("the venv's python runs");
+    assert!(
+        pip.status.success() && has_meshio(&python),
+        "cannot install meshio from PyPI into {}: {}\n\
+         check the network, or install it yourself: {} -m pip install meshio",
+        venv.display(),
+        String::from_utf8_lossy(&pip.stderr),
+        python.display()
+    );
+    python
+}
+
+const READ: &str = r#"
+import json, sys, meshio
+m = meshio.read(sys.argv[1])
+print(json.dumps({
+    "points": m.points.tolist(),
+    "cells": [[c.type, c.data.tolist()] for c in m.cells],
+    "point_data": {k: v.tolist() for k, v in m.point_data.items()},
+    "cell_data": {k: [a.tolist() for a in v] for k, v in m.cell_data.items()},
+}))
+"#;
+
+fn read_vtu(python: &Path, file: &Path) -> Value {
+    let o = Command::new(python)
+        .args(["-c", READ])
+        .arg(file)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "meshio cannot read {}: {}",
+        file.display(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+fn run_with_vtk(scene: &str, out: &Path) -> PathBuf {
+    let mut world = load_scene(Path::new(scene)).unwrap();
+    world.pictures.vtk = true;
+    run(&world, out, &|| {}).unwrap();
+    out.join(&world.name)
+}
+
+fn step(dir: &Path, k: usize) -> StepResult {
+    serde_json::from_slice(&std::fs::read(dir.join(format!("steps/{k:04}.json"))).unwrap()).unwrap()
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap()
+}
+
+#[test]
+fn vtu_files_parse_with_meshio_and_carry_the_step_values() {
+    let python = meshio_python();
+    let out = tempfile::tempdir().unwrap();
+
+    // 2D: members as lines, overloaded flags, loads and reactions as point data.
+    let dir = run_with_vtk("scenes/paper_overload.toml", out.path());
+    let model: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("model.json")).unwrap()).unwrap();
+    let r = step(&dir, 10);
+    let b = &r.bodies[0];
+    let v = read_vtu(&python, &dir.join("vtk/0010.vtu"));
+    let points = v["points"].as_array().unwrap();
+    assert_eq!(points.len(), b.positions.len());
+    for (p, q) in points.iter().zip(&b.positions) {
+        assert_eq!(f(&p[0]), q[0]);
+        assert_eq!(f(&p[1]), q[1]);
+        assert_eq!(f(&p[2]), 0.0);
+    }
+    let cells = v["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 1);
+    assert_eq!(cells[0][0], "line");
+    let lines = cells[0][1].as_array().unwrap();
+    let members = model["bodies"][0]["members"].as_array().unwrap();
+    assert_eq!(lines.len(), members.len());
+    for (l, m) in lines.iter().zip(members) {
+        assert_eq!(l[0].as_u64().unwrap() + 1, m[0].as_u64().unwrap());
+        assert_eq!(l[1].as_u64().unwrap() + 1, m[1].as_u64().unwrap());
+    }
+    let cd = &v["cell_data"];
+    for (j, s) in b.stresses.iter().enumerate() {
+        assert_eq!(f(&cd["stress"][0][j]), *s);
+        assert_eq!(f(&cd["axial_force"][0][j]), b.axial_forces[j]);
+        let flagged = cd["overloaded"][0][j].as_i64().unwrap() == 1;
+        assert_eq!(flagged, b.overloaded.contains(&(j + 1)), "member {}", j + 1);
+    }
+    assert!(!b.overloaded.is_empty());
+    let pd = &v["point_data"];
+    for (n, u) in b.displacements.iter().enumerate() {
+        assert_eq!(f(&pd["displacement"][n][0]), u[0]);
+        assert_eq!(f(&pd["displacement"][n][1]), u[1]);
+    }
+    for l in &b.loads {
+        assert_eq!(f(&pd["applied_force"][l.node - 1][0]), l.force[0]);
+    }
+    for reaction in &b.reactions {
+        assert_eq!(f(&pd["reaction"][reaction.node - 1][1]), reaction.force[1]);
+    }
+    // The collection plays the steps with the load factor as time.
+    let pvd = std::fs::read_to_string(dir.join("vtk/paper_overload.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 11);
+    assert!(pvd.contains("timestep=\"0.5\" group=\"\" part=\"0\" file=\"0005.vtu\""));
+
+    // 3D: patches as triangles with the mean stress of their edge members.
+    let dir = run_with_vtk("scenes/paper_shell.toml", out.path());
+    let model: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("model.json")).unwrap()).unwrap();
+    let r = step(&dir, 4);
+    let b = &r.bodies[0];
+    let v = read_vtu(&python, &dir.join("vtk/0004.vtu"));
+    let cells = v["cells"].as_array().unwrap();
+    let types: Vec<&str> = cells.iter().map(|c| c[0].as_str().unwrap()).collect();
+    assert_eq!(types, ["line", "triangle"]);
+    let patches = model["bodies"][0]["patches"].as_array().unwrap();
+    let members: Vec<[u64; 2]> = model["bodies"][0]["members"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| [m[0].as_u64().unwrap(), m[1].as_u64().unwrap()])
+        .collect();
+    assert_eq!(cells[1][1].as_array().unwrap().len(), patches.len());
+    let p = &patches[5];
+    let nodes: Vec<u64> = (0..3).map(|k| p[k].as_u64().unwrap()).collect();
+    let mut sum = 0.0;
+    let mut count = 0;
+    for k in 0..3 {
+        let (a, c) = (nodes[k], nodes[(k + 1) % 3]);
+        if let Some(j) = members
+            .iter()
+            .position(|m| (m[0] == a && m[1] == c) || (m[0] == c && m[1] == a))
+        {
+            sum += b.stresses[j];
+            count += 1;
+        }
+    }
+    assert_eq!(count, 3);
+    let got = f(&v["cell_data"]["stress"][1][5]);
+    assert!(
+        (got - sum / 3.0).abs() <= 1e-9 * got.abs().max(1.0),
+        "{got}"
+    );
+    assert_eq!(v["cell_data"]["overloaded"][1][5].as_i64().unwrap(), 0);
+    assert_eq!(v["points"][7][2].as_f64().unwrap(), b.positions[7][2]);
+}
+
+#[test]
+fn a_falling_load_plays_by_step_number_in_paraview() {
+    // ParaView needs increasing times: with a load that falls, the .pvd uses step numbers.
+    let text = r#"
+name = "falling"
+steps = 3
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "bar"
+rectangle = { width = 1.0, height = 0.5, cells = [2, 1] }
+[[bodies.supports]]
+nearest = [0.0, 0.0]
+fix = ["x", "y"]
+[[bodies.supports]]
+nearest = [1.0, 0.0]
+fix = ["y"]
+[[bodies.loads]]
+nearest = [1.0, 0.5]
+force = [100.0, 0.0]
+schedule = [1.0, 0.5, 0.25]
+[output]
+vtk = true
+"#;
+    let out = tempfile::tempdir().unwrap();
+    let world = linkage::scene::build_world(text, &out.path().join("s.toml")).unwrap();
+    run(&world, out.path(), &|| {}).unwrap();
+    let pvd = std::fs::read_to_string(out.path().join("falling/vtk/falling.pvd")).unwrap();
+    for k in 0..=3 {
+        assert!(
+            pvd.contains(&format!(
+                "timestep=\"{k}\" group=\"\" part=\"0\" file=\"{k:04}.vtu\""
+            )),
+            "{pvd}"
+        );
+    }
+}
