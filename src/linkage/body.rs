@@ -1,4 +1,4 @@
-use crate::linkage::{Geometry, Kinematics, Material, NewtonSettings, PathMethod};
+use crate::linkage::{Geometry, Kinematics, Material, NewtonSettings, PathMethod, SolverSettings};
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -113,6 +113,8 @@ pub struct Body {
     pub kinematics: Kinematics,
     /// How a nonlinear body (large kinematics, or tension- or compression-only members) is solved.
     pub newton: NewtonSettings,
+    /// Which linear solver `K_ff` gets, and the iterative solver's stopping rule.
+    pub solver: SolverSettings,
 }
 
 /// Why a body cannot be solved as given. Numbers in messages are 1-based.
@@ -229,10 +231,7 @@ impl Body {
                 .collect(),
             patches: geometry.patches,
             materials: vec![material],
-            supports: Vec::new(),
-            loads: Vec::new(),
-            kinematics: Kinematics::Linear,
-            newton: NewtonSettings::default(),
+            ..Default::default()
         }
     }
 

@@ -39,6 +39,18 @@ impl BodySolver {
         }
     }
 
+    /// Which linear solver produced the answers: "direct", "iterative", or "iterative, then
+    /// direct" when conjugate gradients did not converge on a linear body.
+    pub fn solver_used(&self) -> &'static str {
+        match self {
+            BodySolver::Linear(eq) => eq.solver_used,
+            BodySolver::Nonlinear(newton) => newton
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner())
+                .solver_used(),
+        }
+    }
+
     /// Rows of `K_ff`.
     pub fn free_dofs(&self) -> usize {
         match self {

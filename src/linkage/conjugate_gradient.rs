@@ -12,6 +12,10 @@ pub struct CgSettings {
     pub tolerance: Real,
     /// Give up after this many iterations (default 10,000).
     pub max_iterations: usize,
+    /// A force scale, N: the target becomes `tolerance · max(‖b‖, reference_norm)`, so a
+    /// Newton correction whose right-hand side is already tiny against the load is not solved
+    /// to round-off (default 0: relative to ‖b‖ alone).
+    pub reference_norm: Real,
 }
 
 impl Default for CgSettings {
@@ -19,6 +23,7 @@ impl Default for CgSettings {
         CgSettings {
             tolerance: 1e-10,
             max_iterations: 10_000,
+            reference_norm: 0.0,
         }
     }
 }
@@ -28,7 +33,8 @@ impl Default for CgSettings {
 pub struct CgReport {
     /// Iterations run.
     pub iterations: usize,
-    /// True relative residual ‖b − A x‖ / ‖b‖ of the returned x, recomputed from scratch.
+    /// True relative residual ‖b − A x‖ / max(‖b‖, reference) of the returned x, recomputed
+    /// from scratch.
     pub residual: Real,
     /// Whether the tolerance was reached.
     pub converged: bool,
@@ -58,7 +64,8 @@ pub fn conjugate_gradient(
         x.iter_mut().for_each(|v| *v = 0.0);
         return report;
     }
-    let target = settings.tolerance * b_norm;
+    let scale = b_norm.max(settings.reference_norm);
+    let target = settings.tolerance * scale;
     let mut r = vec![0.0; n];
     let mut z = vec![0.0; n];
     let mut p = vec![0.0; n];
@@ -69,7 +76,13 @@ pub fn conjugate_gradient(
         a.multiply(x, &mut r);
         r.par_iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
         let mut r_norm = dot(&r, &r).sqrt();
-        report.residual = r_norm / b_norm;
+        if report.iterations == 0 && r_norm > b_norm {
+            // The initial guess is worse than none: start from zero.
+            x.iter_mut().for_each(|v| *v = 0.0);
+            r.copy_from_slice(b);
+            r_norm = b_norm;
+        }
+        report.residual = r_norm / scale;
         if r_norm <= target || report.iterations >= settings.max_iterations || report.breakdown {
             break;
         }
@@ -200,6 +213,7 @@ mod tests {
         let settings = CgSettings {
             tolerance: 1e-30,
             max_iterations: 50,
+            reference_norm: 0.0,
         };
         let r = conjugate_gradient(&csr, &mut m, &b, &mut x, settings);
         assert!(!r.converged);

@@ -1,5 +1,6 @@
 use crate::linkage::assembly::ModelTooLarge;
 use crate::linkage::cholesky::{CholeskyError, SparseCholesky};
+use crate::linkage::iterative_solver::IterativeSolver;
 use crate::linkage::mechanism::{diagnose_mechanism, Mechanism};
 use crate::linkage::step_state::post_process;
 use crate::linkage::{
@@ -59,6 +60,22 @@ pub enum SolveError {
         /// Relative residual after each iteration of the last attempt.
         history: Vec<Real>,
     },
+    /// The iterative solver did not converge and the direct solver would not fit in memory.
+    #[error("body '{body}': conjugate gradients stopped at relative residual {residual:e} after {iterations} iterations ({when}), and the direct solver would need {needed_mb} MB of the {available_mb} MB available: raise [bodies.solver] max_iterations, loosen its tolerance, or check the body for a mechanism (nodes held by nothing)")]
+    IterativeFailed {
+        /// Body name.
+        body: String,
+        /// Which solve (load patterns, or a step).
+        when: String,
+        /// Relative residual reached.
+        residual: Real,
+        /// Iterations run.
+        iterations: usize,
+        /// Memory the factor would need, MB.
+        needed_mb: u64,
+        /// Memory available, MB.
+        available_mb: u64,
+    },
     /// The solve returned a result that does not satisfy equilibrium.
     #[error("body '{body}': the solution misses equilibrium by {residual:e} (relative): the stiffness matrix is too ill-conditioned (members of very different stiffness, or nearly collinear members); check the materials and the geometry")]
     Inaccurate {
@@ -91,8 +108,13 @@ pub struct Equilibrium {
     pub values: Vec<Real>,
     /// Time spent in each phase, s.
     pub times: PhaseTimes,
-    /// Entries of the Cholesky factor (0 when nothing is free).
+    /// Entries of the Cholesky factor (0 when nothing is free or solved iteratively).
     pub factor_entries: usize,
+    /// Which solver produced the answer: "direct", "iterative", or "iterative, then direct"
+    /// when conjugate gradients did not converge.
+    pub solver_used: &'static str,
+    /// Conjugate-gradient iterations, all load patterns.
+    pub linear_iterations: usize,
     patterns: Vec<LoadPattern>,
     stiffness: Vec<Real>,
 }
@@ -131,16 +153,74 @@ impl Equilibrium {
             values,
             times,
             factor_entries: 0,
+            solver_used: "direct",
+            linear_iterations: 0,
             patterns: Vec::new(),
             stiffness,
         };
+        let mut fell_back = None;
+        if eq.assembly.n > 0
+            && body
+                .solver
+                .use_iterative(eq.dofs.dofs_per_node, eq.assembly.n)
+        {
+            let t = Instant::now();
+            let mut it =
+                IterativeSolver::new(&eq.assembly, &eq.dofs, &body.nodes, body.solver.iterative);
+            it.refill(&eq.values);
+            eq.times.symbolic = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let mut failure = None;
+            let patterns = eq.solve_patterns(body, &mut |rhs: &mut [Real]| {
+                let mut x = vec![0.0; rhs.len()];
+                match it.solve(rhs, &mut x, 0.0) {
+                    Ok(report) if report.converged => {
+                        rhs.copy_from_slice(&x);
+                        true
+                    }
+                    Ok(report) => {
+                        failure = Some((report.residual, report.iterations));
+                        false
+                    }
+                    Err(_) => {
+                        failure = Some((Real::INFINITY, 0));
+                        false
+                    }
+                }
+            });
+            eq.times.solve = t.elapsed().as_secs_f64();
+            eq.linear_iterations = it.iterations;
+            if let Some(patterns) = patterns {
+                eq.patterns = patterns;
+                eq.solver_used = "iterative";
+                return Ok(eq);
+            }
+            // Conjugate gradients failed: the direct solver decides (and names a mechanism).
+            fell_back = failure;
+            eq.solver_used = "iterative, then direct";
+        }
         let mut cholesky = None;
         if eq.assembly.n > 0 {
             let t = Instant::now();
             let a = &eq.assembly;
             let mut c = SparseCholesky::analyze(a.n, &a.col_ptr, &a.row_idx, Some(&a.groups))
                 .map_err(|e| eq.factorization_error(body, e))?;
-            eq.times.symbolic = t.elapsed().as_secs_f64();
+            eq.times.symbolic += t.elapsed().as_secs_f64();
+            if let Some((residual, iterations)) = fell_back {
+                let needed = c.stats().factor_values as u64 * 8;
+                if let Some(available) = available_memory() {
+                    if needed > available / 10 * 8 {
+                        return Err(SolveError::IterativeFailed {
+                            body: body.name.clone(),
+                            when: "solving its load patterns".to_string(),
+                            residual,
+                            iterations,
+                            needed_mb: needed >> 20,
+                            available_mb: available >> 20,
+                        });
+                    }
+                }
+            }
             let t = Instant::now();
             if let Err(e) = c.factorize(&eq.values) {
                 return Err(eq.singular(body, &mut c, e));
@@ -150,8 +230,14 @@ impl Equilibrium {
             cholesky = Some(c);
         }
         let t = Instant::now();
-        eq.patterns = eq.solve_patterns(body, cholesky.as_mut());
-        eq.times.solve = t.elapsed().as_secs_f64();
+        let patterns = eq.solve_patterns(body, &mut |rhs: &mut [Real]| {
+            if let Some(c) = cholesky.as_mut() {
+                c.solve_in_place(rhs);
+            }
+            true
+        });
+        eq.patterns = patterns.unwrap_or_default();
+        eq.times.solve += t.elapsed().as_secs_f64();
         Ok(eq)
     }
 
@@ -180,12 +266,13 @@ impl Equilibrium {
     }
 
     /// Group loads and prescribed displacements by schedule and solve `K_ff U_f = F_f − K_fs U_s`
-    /// (paper Eq. 6 with non-zero `U_s`) once for each group.
+    /// (paper Eq. 6 with non-zero `U_s`) once for each group. `solve` replaces a right-hand
+    /// side by its solution, or says it could not (then `None`).
     fn solve_patterns(
         &self,
         body: &Body,
-        mut cholesky: Option<&mut SparseCholesky>,
-    ) -> Vec<LoadPattern> {
+        solve: &mut dyn FnMut(&mut [Real]) -> bool,
+    ) -> Option<Vec<LoadPattern>> {
         let nd = body.dof_count();
         let d = self.dofs.dofs_per_node;
         let mut patterns: Vec<LoadPattern> = Vec::new();
@@ -225,14 +312,14 @@ impl Equilibrium {
             for (i, &dof) in self.dofs.free.iter().enumerate() {
                 rhs[i] = p.forces[dof] - internal[dof];
             }
-            if let Some(c) = cholesky.as_deref_mut() {
-                c.solve_in_place(&mut rhs);
+            if !rhs.is_empty() && !solve(&mut rhs) {
+                return None;
             }
             for (i, &dof) in self.dofs.free.iter().enumerate() {
                 p.displacements[dof] = rhs[i];
             }
         }
-        patterns
+        Some(patterns)
     }
 
     /// `K u` for a displacement per body DOF, summed member by member, N.
@@ -284,6 +371,10 @@ impl Equilibrium {
         });
         let mut state = post_process(body, &self.dofs, &u, &forces, &internal, members);
         state.iterations = usize::from(step > 0);
+        if step == 1 {
+            // Every load pattern was solved before the first step.
+            state.linear_iterations = self.linear_iterations;
+        }
         if !state.residual.is_finite() || state.residual > 1e-6 {
             return Err(SolveError::Inaccurate {
                 body: body.name.clone(),
@@ -302,4 +393,12 @@ fn format_history(history: &[Real]) -> String {
 /// Unit vector from node `a` to node `b` in the undeformed body.
 fn axis(body: &Body, a: usize, b: usize) -> Vector3<Real> {
     (body.nodes[b] - body.nodes[a]).normalize()
+}
+
+/// Memory the system can still give this process (MemAvailable), bytes; `None` where unknown.
+pub(crate) fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }

@@ -20,6 +20,9 @@ pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
 pub use self::newton::NewtonEquilibrium;
 pub use self::smoothed_aggregation::{MultigridError, SmoothedAggregation};
+pub use self::solver_choice::{
+    IterativeSettings, SolverChoice, SolverSettings, AUTO_ITERATIVE_DOFS_2D, AUTO_ITERATIVE_DOFS_3D,
+};
 pub use self::step_state::StepState;
 pub use self::symmetric_csr::{dot, Preconditioner, SymmetricCsr};
 
@@ -33,6 +36,7 @@ mod dof_map;
 mod equilibrium;
 pub mod generators;
 mod geometry;
+mod iterative_solver;
 mod kinematics;
 pub mod ldlt;
 mod material;
@@ -43,6 +47,7 @@ mod newton;
 pub mod ordering;
 pub mod paper_files;
 mod smoothed_aggregation;
+mod solver_choice;
 mod step_state;
 mod symmetric_csr;
 mod tangent_solver;

@@ -108,11 +108,12 @@ impl NewtonEquilibrium {
         eq.times.assembly += t.elapsed().as_secs_f64();
         if eq.assembly.n > 0 {
             let t = Instant::now();
-            let solver =
-                TangentSolver::new(&eq.assembly).map_err(|e| SolveError::Factorization {
+            let solver = TangentSolver::new(body, &eq.dofs, &eq.assembly).map_err(|e| {
+                SolveError::Factorization {
                     body: body.name.clone(),
                     message: e.to_string(),
-                })?;
+                }
+            })?;
             eq.times.symbolic += t.elapsed().as_secs_f64();
             eq.solver = Some(solver);
             let t = Instant::now();
@@ -124,7 +125,7 @@ impl NewtonEquilibrium {
             match first {
                 Ok(_) => {}
                 Err(TangentError::Indefinite { dof }) => {
-                    let solver = eq.solver.as_mut().map(|s| s.cholesky_mut());
+                    let solver = eq.solver.as_mut().and_then(|s| s.cholesky_mut());
                     if let Some(c) = solver {
                         return Err(SolveError::Mechanism(Box::new(diagnose_mechanism(
                             body,
@@ -148,6 +149,20 @@ impl NewtonEquilibrium {
         Ok(eq)
     }
 
+    /// Conjugate-gradient iterations so far (0 with the direct solver).
+    pub fn linear_iterations(&self) -> usize {
+        self.solver.as_ref().map_or(0, |s| s.iterations())
+    }
+
+    /// Which linear solver the tangent gets: "direct" or "iterative".
+    pub fn solver_used(&self) -> &'static str {
+        if self.solver.as_ref().is_some_and(|s| s.is_iterative()) {
+            "iterative"
+        } else {
+            "direct"
+        }
+    }
+
     /// The state at `step` of `steps`. Steps are solved in order from the last one solved;
     /// asking for an earlier step restarts from the undeformed state.
     pub fn solve_step(
@@ -167,6 +182,7 @@ impl NewtonEquilibrium {
         }
         let mut iterations = 0;
         let mut cuts = 0;
+        let cg_before = self.linear_iterations();
         while self.step < step {
             let target = self.step + 1;
             let (i, c) = match body.newton.path {
@@ -182,6 +198,7 @@ impl NewtonEquilibrium {
         let mut state = self.state(body, steps);
         state.iterations = iterations;
         state.cuts = cuts;
+        state.linear_iterations = self.linear_iterations() - cg_before;
         if step > 0 {
             state.residual_history = self.residual_history.clone();
         }
@@ -307,7 +324,7 @@ impl NewtonEquilibrium {
         let Some(solver) = self.solver.as_mut() else {
             return Ok(0);
         };
-        let negative = solver.factorize(&self.assembly, &self.values)?;
+        let negative = solver.factorize(&self.values)?;
         self.negative_pivots = negative;
         Ok(negative)
     }
@@ -320,26 +337,32 @@ impl NewtonEquilibrium {
         let t = Instant::now();
         let result = self.factorize();
         self.times.numeric += t.elapsed().as_secs_f64();
-        match result {
-            Ok(_) => Ok(()),
-            Err(TangentError::Indefinite { dof }) => {
+        result.map(|_| ()).map_err(|e| self.describe(e))
+    }
+
+    /// What a failed tangent factorization means for the user.
+    fn describe(&self, error: TangentError) -> String {
+        match error {
+            TangentError::Indefinite { dof } => {
                 let (node, dir) = self.dofs.node_and_direction(self.dofs.free[dof]);
-                Err(format!(
+                format!(
                     "the tangent stiffness is singular or indefinite at node {} ({}): the body is at or past a limit point or buckles",
                     node + 1,
                     direction_name(dir)
-                ))
+                )
             }
-            Err(TangentError::Other(m)) => Err(m),
+            TangentError::Other(m) => m,
         }
     }
 
-    fn solve(&mut self, rhs: &mut [Real]) {
+    fn solve(&mut self, rhs: &mut [Real]) -> Result<(), String> {
         let t = Instant::now();
-        if let Some(s) = self.solver.as_mut() {
-            s.solve_in_place(rhs);
-        }
+        let result = match self.solver.as_mut() {
+            Some(s) => s.solve_in_place(rhs),
+            None => Ok(()),
+        };
         self.times.solve += t.elapsed().as_secs_f64();
+        result.map_err(|e| self.describe(e))
     }
 
     /// Internal forces and the free out-of-balance `F − f_int` at the current displacement
@@ -406,6 +429,9 @@ impl NewtonEquilibrium {
         let nd = body.dof_count();
         let forces = self.forces_at(body, t1, steps);
         let prescribed = self.prescribed_at(body, t1, steps);
+        if let Some(s) = self.solver.as_mut() {
+            s.set_reference(norm(&forces));
+        }
         let mut history = Vec::new();
         let fail = |reason: String, history: &Vec<Real>| IncrementFailure {
             reason,
@@ -428,7 +454,7 @@ impl NewtonEquilibrium {
                 rhs[i] -= k_du[dof];
             }
         }
-        self.solve(&mut rhs);
+        self.solve(&mut rhs).map_err(|r| fail(r, &history))?;
         for &dof in &self.dofs.supported {
             self.u[dof] = prescribed[dof];
         }
@@ -481,7 +507,7 @@ impl NewtonEquilibrium {
             self.refactor(body)
                 .map_err(|reason| fail(reason, &history))?;
             let mut delta = r.clone();
-            self.solve(&mut delta);
+            self.solve(&mut delta).map_err(|r| fail(r, &history))?;
             last_step = self.line_search(body, &forces, &delta, rnorm, &mut internal);
             iterations += 1;
         }
@@ -589,7 +615,7 @@ impl NewtonEquilibrium {
         let lambda0 = self.lambda;
         self.refactor(body).map_err(|r| fail(r, &history))?;
         let mut dt = ref_f.clone();
-        self.solve(&mut dt);
+        self.solve(&mut dt).map_err(|r| fail(r, &history))?;
         let dt_norm = norm(&dt);
         if !(dt_norm.is_finite() && dt_norm > 0.0) {
             return Err(fail(
@@ -641,9 +667,9 @@ impl NewtonEquilibrium {
             self.refactor(body)
                 .map_err(|reason| fail(reason, &history))?;
             let mut dr = r;
-            self.solve(&mut dr);
+            self.solve(&mut dr).map_err(|r| fail(r, &history))?;
             let mut dt = ref_f.clone();
-            self.solve(&mut dt);
+            self.solve(&mut dt).map_err(|r| fail(r, &history))?;
             // |Δu + δu_R + δλ δu_t|² = arc²
             let base: Vec<Real> = du.iter().zip(&dr).map(|(a, b)| a + b).collect();
             let a = dot_product(&dt, &dt);

@@ -29,6 +29,8 @@ pub struct StepState {
     pub iterations: usize,
     /// How many times the step's load increment was halved because Newton did not converge.
     pub cuts: usize,
+    /// Conjugate-gradient iterations this step's solves took (0 with the direct solver).
+    pub linear_iterations: usize,
     /// Relative residual after each Newton iteration of the step's last increment (empty for a
     /// linear step): shows the convergence rate.
     pub residual_history: Vec<Real>,

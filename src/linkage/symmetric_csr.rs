@@ -107,6 +107,15 @@ impl SymmetricCsr {
         }
     }
 
+    /// The lower-triangle values in the order they were given to [`SymmetricCsr::refill`].
+    pub fn lower_values(&self, count: usize) -> Vec<Real> {
+        self.from_lower
+            .iter()
+            .take(count)
+            .map(|places| self.val[places[0] as usize])
+            .collect()
+    }
+
     /// The diagonal entry of every row.
     pub fn diagonal(&self) -> Vec<Real> {
         (0..self.n)

@@ -4,7 +4,7 @@ use crate::linkage::generators;
 use crate::linkage::paper_files::{self, PaperFileError};
 use crate::linkage::{
     Behaviour, Body, Dimension, Geometry, Kinematics, Material, Member, NewtonSettings, NodalLoad,
-    PathMethod, Schedule, Support,
+    PathMethod, Schedule, SolverChoice, SolverSettings, Support,
 };
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
@@ -217,13 +217,47 @@ fn build_body(
         }
     };
     let newton = newton_settings(spec).map_err(here)?;
-    match spec.solver.as_deref() {
-        None | Some("direct") | Some("auto") => {}
-        Some(other) => {
-            return Err(here(format!(
-                "solver = {other:?} is not available: use \"direct\" or \"auto\""
-            )))
+    let mut solver = SolverSettings {
+        choice: match spec.solver.as_deref() {
+            None | Some("auto") => SolverChoice::Auto,
+            Some("direct") => SolverChoice::Direct,
+            Some("iterative") => SolverChoice::Iterative,
+            Some(other) => {
+                return Err(here(format!(
+                    "solver = {other:?} is not available: use \"direct\", \"iterative\" or \"auto\""
+                )))
+            }
+        },
+        ..Default::default()
+    };
+    if let Some(it) = &spec.iterative {
+        if let Some(t) = it.tolerance {
+            if !(t.is_finite() && t > 0.0 && t < 1.0) {
+                return Err(here(format!(
+                    "[bodies.iterative] tolerance = {t}: give a relative residual between 0 and 1, e.g. 1e-10"
+                )));
+            }
+            solver.iterative.tolerance = t;
         }
+        if let Some(m) = it.max_iterations {
+            if m == 0 {
+                return Err(here(
+                    "[bodies.iterative] max_iterations = 0: give 1 or more".to_string(),
+                ));
+            }
+            solver.iterative.max_iterations = m;
+        }
+        if let Some(w) = it.warm_start {
+            solver.iterative.warm_start = w;
+        }
+    }
+    if solver.choice == SolverChoice::Iterative && newton.path != PathMethod::Schedules {
+        return Err(here(
+            "solver = \"iterative\" cannot follow an arc-length path (it counts the tangent's negative pivots, which needs a factorization): use solver = \"direct\" or \"auto\"".to_string(),
+        ));
+    }
+    if newton.path != PathMethod::Schedules {
+        solver.choice = SolverChoice::Direct;
     }
     let material_index = |name: &str| materials.iter().position(|m| m.name == name);
     let default_material = match &spec.material {
@@ -262,6 +296,7 @@ fn build_body(
     body.materials = materials.to_vec();
     body.kinematics = kinematics;
     body.newton = newton;
+    body.solver = solver;
     if from_files {
         let (Some(nodes_file), Some(links_file)) = (&spec.nodes, &spec.links) else {
             return Err(here(

@@ -85,6 +85,10 @@ pub struct StepSummary {
     pub negative_pivots: usize,
     /// Contact iterations (0 without contact).
     pub contact_iterations: usize,
+    /// Conjugate-gradient iterations of the step's solves, all bodies (0 with the direct
+    /// solver; a linear body solves all its load patterns before step 1 and counts them there).
+    #[serde(default)]
+    pub linear_iterations: usize,
     /// Relative out-of-balance force, largest over the bodies.
     pub residual: Real,
     /// Largest node displacement, m.
@@ -112,6 +116,10 @@ pub struct BodySize {
     pub patches: usize,
     /// Free DOFs (size of `K_ff`).
     pub free_dofs: usize,
+    /// The linear solver used: "direct", "iterative", or "iterative, then direct" when
+    /// conjugate gradients did not converge.
+    #[serde(default)]
+    pub solver: String,
 }
 
 /// Wall time of the run's phases, s, summed over bodies.

@@ -78,6 +78,7 @@ impl<'w> Simulation<'w> {
             negative_pivots: 0,
             residuals: Vec::new(),
             contact_iterations: 0,
+            linear_iterations: 0,
             residual: 0.0,
             max_displacement: 0.0,
             overloaded: 0,
@@ -97,6 +98,7 @@ impl<'w> Simulation<'w> {
             }
             summary.iterations = summary.iterations.max(state.iterations);
             summary.cuts += state.cuts;
+            summary.linear_iterations += state.linear_iterations;
             summary.negative_pivots += state.negative_pivots;
             if let Some(lambda) = state.load_factor {
                 // The path (arc length) decided this body's load factor.
@@ -127,6 +129,7 @@ impl<'w> Simulation<'w> {
                 members: b.members.len(),
                 patches: b.patches.len(),
                 free_dofs: eq.free_dofs(),
+                solver: eq.solver_used().to_string(),
             })
             .collect()
     }

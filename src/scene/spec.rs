@@ -68,8 +68,10 @@ pub struct BodySpec {
     pub newton: Option<NewtonSpec>,
     /// How the load path is followed (schedules or arc length).
     pub path: Option<PathSpec>,
-    /// `"direct"` or `"auto"` (default).
+    /// `"direct"`, `"iterative"` or `"auto"` (default).
     pub solver: Option<String>,
+    /// Stopping rule of the iterative solver.
+    pub iterative: Option<IterativeSpec>,
     /// Generated circular disk (paper Fig. 1).
     pub disk: Option<DiskSpec>,
     /// Generated 2D rectangular solid (paper Fig. 4–6).
@@ -98,6 +100,18 @@ pub struct NewtonSpec {
     pub max_iterations: Option<usize>,
     /// Smallest increment `1/2^max_cuts` of a step (default 10).
     pub max_cuts: Option<usize>,
+}
+
+/// `[bodies.iterative]`: when conjugate gradients stop (see `docs/SCENES.md`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IterativeSpec {
+    /// Relative residual at which a solve stops (default 1e-10).
+    pub tolerance: Option<Real>,
+    /// Iterations per solve before falling back to the direct solver (default 500).
+    pub max_iterations: Option<usize>,
+    /// Start each solve from the last solution (default true).
+    pub warm_start: Option<bool>,
 }
 
 /// `[bodies.path]`: `method = "schedules"` (default) or `"arc_length"` with `arc_length` (m).

@@ -1,0 +1,189 @@
+//! `K_ff x = b` by conjugate gradients with a smoothed-aggregation multigrid preconditioner:
+//! the pattern in full rows is built once, the values refilled, the hierarchy rebuilt only when
+//! the matrix has drifted far enough that the iterations grow, every solve warm-started.
+
+use crate::linkage::{
+    conjugate_gradient, dot, CgReport, CgSettings, DofMap, IterativeSettings, MultigridError,
+    SmoothedAggregation, StiffnessAssembly, SymmetricCsr,
+};
+use crate::Real;
+use nalgebra::Vector3;
+
+/// Past solutions kept for warm starts.
+const WARM_START_VECTORS: usize = 6;
+
+/// The iterative solver of one body's `K_ff`.
+pub(crate) struct IterativeSolver {
+    matrix: SymmetricCsr,
+    multigrid: Option<SmoothedAggregation>,
+    groups: Vec<usize>,
+    directions: Vec<usize>,
+    nodes: Vec<Vector3<Real>>,
+    dimension: usize,
+    settings: IterativeSettings,
+    /// Iterations of the first solve with the current hierarchy: the yardstick for rebuilding.
+    fresh_iterations: Option<usize>,
+    /// Whether the values changed since the hierarchy was built.
+    stale: bool,
+    /// Recent (solution, right-hand side) pairs, newest last: the warm start is the best
+    /// combination of these solutions for the new right-hand side.
+    history: std::collections::VecDeque<(Vec<Real>, Vec<Real>)>,
+    /// Conjugate-gradient iterations, all solves.
+    pub iterations: usize,
+    /// The report of the last solve.
+    pub last: Option<CgReport>,
+}
+
+impl IterativeSolver {
+    /// The full-row pattern of `K_ff` for `assembly` (values zero until [`Self::refill`]).
+    pub(crate) fn new(
+        assembly: &StiffnessAssembly,
+        dofs: &DofMap,
+        nodes: &[Vector3<Real>],
+        settings: IterativeSettings,
+    ) -> Self {
+        IterativeSolver {
+            matrix: SymmetricCsr::from_lower(assembly.n, &assembly.col_ptr, &assembly.row_idx),
+            multigrid: None,
+            groups: assembly.groups.clone(),
+            directions: dofs.free.iter().map(|d| d % dofs.dofs_per_node).collect(),
+            nodes: nodes.to_vec(),
+            dimension: dofs.dofs_per_node,
+            settings,
+            fresh_iterations: None,
+            stale: false,
+            history: std::collections::VecDeque::new(),
+            iterations: 0,
+            last: None,
+        }
+    }
+
+    /// New values of `K_ff` (lower triangle in the assembly's order). The hierarchy is kept: it
+    /// still preconditions a nearby matrix well, and is rebuilt when the iterations say so.
+    pub(crate) fn refill(&mut self, lower_values: &[Real]) {
+        self.matrix.refill(lower_values);
+        self.stale = self.multigrid.is_some();
+    }
+
+    fn rebuild(&mut self) -> Result<(), MultigridError> {
+        self.multigrid = None;
+        self.multigrid = Some(SmoothedAggregation::new(
+            &self.matrix,
+            &self.groups,
+            &self.directions,
+            &self.nodes,
+            self.dimension,
+        )?);
+        self.fresh_iterations = None;
+        self.stale = false;
+        Ok(())
+    }
+
+    /// Solve `K x = b` to `‖b − K x‖ ≤ tolerance · max(‖b‖, reference)`, starting from the best
+    /// guess at hand (see [`Self::warm_start`]). Returns the report; `x` holds the answer (or
+    /// the last iterate).
+    ///
+    /// For a Newton correction `K δ = r`, `reference` is the load's norm: this is exactly
+    /// solving for the new displacement `K u_new = K u_old + r` to `tolerance` of the load,
+    /// warm-started from the previous iterate `u_old`. With warm starts off, each solve starts
+    /// from zero and is taken to `tolerance` of its own right-hand side, as a cold solve of the
+    /// new displacement would be.
+    pub(crate) fn solve(
+        &mut self,
+        b: &[Real],
+        x: &mut [Real],
+        reference: Real,
+    ) -> Result<CgReport, MultigridError> {
+        if self.multigrid.is_none() {
+            self.rebuild()?;
+        }
+        self.warm_start(b, x);
+        let settings = CgSettings {
+            tolerance: self.settings.tolerance,
+            max_iterations: self.settings.max_iterations,
+            reference_norm: if self.settings.warm_start {
+                reference
+            } else {
+                0.0
+            },
+        };
+        let mut report = self.run(b, x, settings);
+        // A hierarchy built for an older matrix that now needs many more iterations (or fails)
+        // is rebuilt, and the solve continues from where it stopped.
+        let yardstick = self.fresh_iterations.unwrap_or(usize::MAX);
+        if self.stale && (!report.converged || report.iterations > 2 * yardstick + 4) {
+            self.rebuild()?;
+            let more = self.run(b, x, settings);
+            report = CgReport {
+                iterations: report.iterations + more.iterations,
+                ..more
+            };
+            self.fresh_iterations = Some(more.iterations);
+        } else if self.fresh_iterations.is_none() {
+            self.fresh_iterations = Some(report.iterations);
+        }
+        self.last = Some(report);
+        if report.converged && self.settings.warm_start {
+            if self.history.len() == WARM_START_VECTORS {
+                self.history.pop_front();
+            }
+            self.history.push_back((x.to_vec(), b.to_vec()));
+        }
+        Ok(report)
+    }
+
+    fn run(&mut self, b: &[Real], x: &mut [Real], settings: CgSettings) -> CgReport {
+        let Some(m) = self.multigrid.as_mut() else {
+            return CgReport {
+                iterations: 0,
+                residual: Real::INFINITY,
+                converged: false,
+                breakdown: true,
+            };
+        };
+        let report = conjugate_gradient(&self.matrix, m, b, x, settings);
+        self.iterations += report.iterations;
+        report
+    }
+
+    /// The Galerkin combination of recent solutions: x = V c with (Vᵀ K V) c = Vᵀ b. Since a
+    /// converged x_i satisfies K x_i = b_i to the tolerance, K V is the stored right-hand sides,
+    /// so this costs no product with K. It contains the last step's answer scaled to the new
+    /// load and the last Newton correction; the solver starts from zero if it is worse.
+    fn warm_start(&self, b: &[Real], x: &mut [Real]) {
+        let k = self.history.len();
+        if !self.settings.warm_start || k == 0 || x.iter().any(|v| *v != 0.0) {
+            return;
+        }
+        // Symmetrised Vᵀ K V (the stored b_i = K x_i only to the tolerance).
+        let g = nalgebra::DMatrix::from_fn(k, k, |i, j| {
+            0.5 * (dot(&self.history[i].0, &self.history[j].1)
+                + dot(&self.history[j].0, &self.history[i].1))
+        });
+        let rhs = nalgebra::DVector::from_fn(k, |i, _| dot(&self.history[i].0, b));
+        let eigen = g.symmetric_eigen();
+        let largest = eigen.eigenvalues.iter().copied().fold(0.0, Real::max);
+        if largest.is_nan() || largest <= 0.0 {
+            return;
+        }
+        // Pseudo-inverse: nearly dependent past solutions add nothing but round-off.
+        let mut c = nalgebra::DVector::zeros(k);
+        for (m, &lambda) in eigen.eigenvalues.iter().enumerate() {
+            if lambda > 1e-10 * largest {
+                let q = eigen.eigenvectors.column(m);
+                c += q * (q.dot(&rhs) / lambda);
+            }
+        }
+        for (i, (v, _)) in self.history.iter().enumerate() {
+            let ci = c[i];
+            if ci != 0.0 && ci.is_finite() {
+                x.iter_mut().zip(v).for_each(|(xi, vi)| *xi += ci * vi);
+            }
+        }
+    }
+
+    /// The current lower-triangle values (for a fallback to the direct solver).
+    pub(crate) fn lower_values(&self, assembly: &StiffnessAssembly) -> Vec<Real> {
+        self.matrix.lower_values(assembly.nnz())
+    }
+}
