@@ -5,7 +5,7 @@
 use crate::bench::peak_memory;
 use crate::linkage::{
     generators, Body, Equilibrium, Kinematics, Material, NewtonEquilibrium, NodalLoad, Schedule,
-    Support,
+    SolverSettings, Support,
 };
 use crate::Real;
 use nalgebra::Vector3;
@@ -52,6 +52,8 @@ pub struct NewtonStepTiming {
     pub cuts: usize,
     /// Relative residual at convergence.
     pub residual: Real,
+    /// Conjugate-gradient iterations of the step (0 with the direct solver).
+    pub linear_iterations: usize,
     /// Largest displacement, m.
     pub max_displacement: Real,
     /// Wall time of the step, s.
@@ -93,9 +95,16 @@ pub struct LargeTiming {
     pub peak_memory: u64,
 }
 
-/// Solve the column linearly, then with large kinematics in `steps` load steps.
-pub fn measure_large(cells: [usize; 3], force: Real, steps: usize) -> Result<LargeTiming, String> {
+/// Solve the column linearly, then with large kinematics in `steps` load steps, with the
+/// linear solver `solver`.
+pub fn measure_large(
+    cells: [usize; 3],
+    force: Real,
+    steps: usize,
+    solver: SolverSettings,
+) -> Result<LargeTiming, String> {
     let mut body = column_body(cells, force)?;
+    body.solver = solver;
     let t = Instant::now();
     let (linear_tip_vec, tip) = {
         let eq = Equilibrium::new(&body).map_err(|e| e.to_string())?;
@@ -126,6 +135,7 @@ pub fn measure_large(cells: [usize; 3], force: Real, steps: usize) -> Result<Lar
             iterations: state.iterations,
             cuts: state.cuts,
             residual: state.residual,
+            linear_iterations: state.linear_iterations,
             max_displacement: state
                 .displacements
                 .iter()
@@ -160,10 +170,11 @@ pub fn measure_large(cells: [usize; 3], force: Real, steps: usize) -> Result<Lar
 /// One line per step.
 pub fn format_step(s: &NewtonStepTiming) -> String {
     format!(
-        "step {:>3}: {:>2} Newton iterations, {} cuts, residual {:.1e}, max |u| {:.4} m, {:.2} s ({:.2} s per iteration)",
+        "step {:>3}: {:>2} Newton iterations, {} cuts, {} CG iterations, residual {:.1e}, max |u| {:.4} m, {:.2} s ({:.2} s per iteration)",
         s.step,
         s.iterations,
         s.cuts,
+        s.linear_iterations,
         s.residual,
         s.max_displacement,
         s.seconds,

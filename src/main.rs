@@ -70,6 +70,10 @@ enum Command {
         /// With --iterative: precondition with block Jacobi instead of multigrid.
         #[arg(long, requires = "iterative")]
         jacobi: bool,
+        /// With --large --iterative: start every conjugate-gradient solve from zero (to
+        /// measure what warm starts save).
+        #[arg(long, requires = "iterative")]
+        cold: bool,
         /// Measure in this process instead of one child process per size (then the peak
         /// memory column is the running maximum).
         #[arg(long, hide = true)]
@@ -190,8 +194,10 @@ fn main() -> ExitCode {
             large: true,
             force,
             steps,
+            iterative,
+            cold,
             ..
-        } => bench_large(cells, force, steps),
+        } => bench_large(cells, force, steps, iterative, cold),
         Command::Bench {
             cells,
             iterative,
@@ -371,12 +377,34 @@ fn export(scene: &Path, out: &Path) -> Result<()> {
     Ok(())
 }
 
-fn bench_large(cells: Vec<[usize; 3]>, force: Option<f64>, steps: Option<usize>) -> Result<()> {
+fn bench_large(
+    cells: Vec<[usize; 3]>,
+    force: Option<f64>,
+    steps: Option<usize>,
+    iterative: bool,
+    cold: bool,
+) -> Result<()> {
+    use linkage::linkage::{SolverChoice, SolverSettings};
     let cells = cells.first().copied().unwrap_or([16, 16, 150]);
     let force = force.unwrap_or(2.5e5);
     let steps = steps.unwrap_or(5);
-    println!("3D column lattice, bottom clamped, top pushed sideways; large displacements by Newton (sparse LLᵀ, METIS order, refactored every iteration)");
-    let t = linkage::bench_large::measure_large(cells, force, steps).map_err(anyhow::Error::msg)?;
+    let mut solver = SolverSettings {
+        choice: if iterative {
+            SolverChoice::Iterative
+        } else {
+            SolverChoice::Direct
+        },
+        ..Default::default()
+    };
+    solver.iterative.warm_start = !cold;
+    let how = match (iterative, cold) {
+        (false, _) => "sparse LLᵀ, METIS order, refactored every iteration",
+        (true, false) => "multigrid conjugate gradients, warm-started",
+        (true, true) => "multigrid conjugate gradients, cold starts",
+    };
+    println!("3D column lattice, bottom clamped, top pushed sideways; large displacements by Newton ({how})");
+    let t = linkage::bench_large::measure_large(cells, force, steps, solver)
+        .map_err(anyhow::Error::msg)?;
     for s in &t.steps {
         println!("{}", linkage::bench_large::format_step(s));
     }
