@@ -69,7 +69,8 @@ pub fn lattice_body(cells: [usize; 3]) -> Result<Body, String> {
 /// Generate, assemble, factor and solve one lattice, timing each phase.
 pub fn measure_lattice(cells: [usize; 3]) -> Result<LatticeTiming, String> {
     let t = Instant::now();
-    let body = lattice_body(cells)?;
+    let mut body = lattice_body(cells)?;
+    body.solver.choice = crate::linkage::SolverChoice::Direct;
     let generate = t.elapsed().as_secs_f64();
     let eq = Equilibrium::new(&body).map_err(|e| e.to_string())?;
     let state = eq.solve_step(&body, 1, 1).map_err(|e| e.to_string())?;
