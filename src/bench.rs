@@ -36,9 +36,19 @@ pub struct LatticeTiming {
     pub peak_memory: u64,
 }
 
-/// A steel lattice of `cells` unit cells (0.01 m each), bottom face fixed, the top face
-/// pushed down and sideways by 1 kN in total.
+/// A steel lattice of `cells` unit cells (0.01 m each, members of 1 mm²), bottom face fixed,
+/// the top face pushed down and sideways by 1 kN in total.
 pub fn lattice_body(cells: [usize; 3]) -> Result<Body, String> {
+    loaded_lattice("lattice", cells, Vector3::new(200.0, 0.0, -1000.0))
+}
+
+/// A steel lattice of `cells` unit cells (0.01 m each, members of 1 mm²) named `name`, its
+/// bottom face clamped, `total_force` (N) shared by the nodes of its top face.
+pub fn loaded_lattice(
+    name: &str,
+    cells: [usize; 3],
+    total_force: Vector3<Real>,
+) -> Result<Body, String> {
     let h = 0.01;
     let size = [
         cells[0] as Real * h,
@@ -46,7 +56,7 @@ pub fn lattice_body(cells: [usize; 3]) -> Result<Body, String> {
         cells[2] as Real * h,
     ];
     let geometry = generators::box_lattice(size, cells).map_err(|e| e.to_string())?;
-    let mut body = Body::from_geometry("lattice", geometry, Material::new("steel", 200e9, 1e-6));
+    let mut body = Body::from_geometry(name, geometry, Material::new("steel", 200e9, 1e-6));
     let top: Vec<usize> = (0..body.nodes.len())
         .filter(|&i| (body.nodes[i].z - size[2]).abs() < 1e-9)
         .collect();
@@ -55,7 +65,7 @@ pub fn lattice_body(cells: [usize; 3]) -> Result<Body, String> {
             body.supports.push(Support::fixed(i, [true, true, true]));
         }
     }
-    let per_node = Vector3::new(200.0, 0.0, -1000.0) / top.len() as Real;
+    let per_node = total_force / top.len() as Real;
     for i in top {
         body.loads.push(NodalLoad {
             node: i,

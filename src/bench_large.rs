@@ -2,11 +2,8 @@
 //! large-displacement solve on a slender 3D box lattice bent far by a side load, against the
 //! linear solve of the same body (see `docs/PERFORMANCE.md`, "Large displacements").
 
-use crate::bench::peak_memory;
-use crate::linkage::{
-    generators, Body, Equilibrium, Kinematics, Material, NewtonEquilibrium, NodalLoad, Schedule,
-    SolverSettings, Support,
-};
+use crate::bench::{loaded_lattice, peak_memory};
+use crate::linkage::{Body, Equilibrium, Kinematics, NewtonEquilibrium, SolverSettings};
 use crate::Real;
 use nalgebra::Vector3;
 use std::time::Instant;
@@ -14,31 +11,7 @@ use std::time::Instant;
 /// A steel column of `cells` unit cells (0.01 m each, members of 1 mm²), its bottom face
 /// clamped, its top face pushed sideways (+x) by `force` N in total.
 pub fn column_body(cells: [usize; 3], force: Real) -> Result<Body, String> {
-    let h = 0.01;
-    let size = [
-        cells[0] as Real * h,
-        cells[1] as Real * h,
-        cells[2] as Real * h,
-    ];
-    let geometry = generators::box_lattice(size, cells).map_err(|e| e.to_string())?;
-    let mut body = Body::from_geometry("column", geometry, Material::new("steel", 200e9, 1e-6));
-    let top: Vec<usize> = (0..body.nodes.len())
-        .filter(|&i| (body.nodes[i].z - size[2]).abs() < 1e-9)
-        .collect();
-    for i in 0..body.nodes.len() {
-        if body.nodes[i].z.abs() < 1e-9 {
-            body.supports.push(Support::fixed(i, [true, true, true]));
-        }
-    }
-    let per_node = Vector3::new(force, 0.0, 0.0) / top.len() as Real;
-    for i in top {
-        body.loads.push(NodalLoad {
-            node: i,
-            force: per_node,
-            schedule: Schedule::Linear,
-        });
-    }
-    Ok(body)
+    loaded_lattice("column", cells, Vector3::new(force, 0.0, 0.0))
 }
 
 /// One load step of the large-displacement solve.

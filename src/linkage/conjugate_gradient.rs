@@ -123,37 +123,13 @@ pub fn conjugate_gradient(
 mod tests {
     use super::*;
     use crate::linkage::cholesky::SparseCholesky;
-    use crate::linkage::{
-        generators, member_block, BlockJacobi, Body, DofMap, Material, StiffnessAssembly, Support,
-    };
+    use crate::linkage::test_lattice::lattice_system;
+    use crate::linkage::{BlockJacobi, StiffnessAssembly};
 
     /// `K_ff` of a small lattice with its bottom fixed, as assembly, values and full rows.
     fn lattice() -> (StiffnessAssembly, Vec<Real>, SymmetricCsr) {
-        let g = generators::box_lattice([0.04, 0.03, 0.05], [4, 3, 5]).unwrap();
-        let mut body = Body::from_geometry("l", g, Material::new("s", 200e9, 1e-6));
-        for i in 0..body.nodes.len() {
-            if body.nodes[i].z == 0.0 {
-                body.supports.push(Support::fixed(i, [true, true, true]));
-            }
-        }
-        let dofs = DofMap::new(&body);
-        let asm = StiffnessAssembly::new(&body, &dofs).unwrap();
-        let mut values = Vec::new();
-        asm.fill(
-            &body,
-            |m| {
-                let [a, b] = body.members[m].nodes;
-                member_block(
-                    &body.nodes[a],
-                    &body.nodes[b],
-                    200e9 * 1e-6 / body.member_length(m),
-                )
-            },
-            &mut values,
-        );
-        let mut csr = SymmetricCsr::from_lower(asm.n, &asm.col_ptr, &asm.row_idx);
-        csr.refill(&values);
-        (asm, values, csr)
+        let s = lattice_system([4, 3, 5]);
+        (s.assembly, s.values, s.matrix)
     }
 
     #[test]

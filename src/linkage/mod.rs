@@ -51,3 +51,5 @@ mod solver_choice;
 mod step_state;
 mod symmetric_csr;
 mod tangent_solver;
+#[cfg(test)]
+mod test_lattice;

@@ -777,51 +777,18 @@ impl Preconditioner for SmoothedAggregation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linkage::{
-        conjugate_gradient, generators, member_block, BlockJacobi, Body, CgSettings, DofMap,
-        Material, StiffnessAssembly, Support,
-    };
-
-    /// A lattice with its bottom face fixed: full-row K_ff, groups, directions and the body.
-    fn lattice(
-        cells: [usize; 3],
-    ) -> (SymmetricCsr, StiffnessAssembly, Vec<Real>, Vec<usize>, Body) {
-        let size = [
-            cells[0] as Real * 0.01,
-            cells[1] as Real * 0.01,
-            cells[2] as Real * 0.01,
-        ];
-        let g = generators::box_lattice(size, cells).unwrap();
-        let mut body = Body::from_geometry("l", g, Material::new("s", 200e9, 1e-6));
-        for i in 0..body.nodes.len() {
-            if body.nodes[i].z == 0.0 {
-                body.supports.push(Support::fixed(i, [true, true, true]));
-            }
-        }
-        let dofs = DofMap::new(&body);
-        let asm = StiffnessAssembly::new(&body, &dofs).unwrap();
-        let mut values = Vec::new();
-        asm.fill(
-            &body,
-            |m| {
-                let [a, b] = body.members[m].nodes;
-                member_block(
-                    &body.nodes[a],
-                    &body.nodes[b],
-                    200e9 * 1e-6 / body.member_length(m),
-                )
-            },
-            &mut values,
-        );
-        let mut csr = SymmetricCsr::from_lower(asm.n, &asm.col_ptr, &asm.row_idx);
-        csr.refill(&values);
-        let directions = dofs.free.iter().map(|d| d % 3).collect();
-        (csr, asm, values, directions, body)
-    }
+    use crate::linkage::test_lattice::{lattice_system, LatticeSystem};
+    use crate::linkage::{conjugate_gradient, BlockJacobi, CgSettings};
 
     #[test]
     fn multigrid_cg_matches_the_direct_solve_in_far_fewer_iterations() {
-        let (csr, asm, values, directions, body) = lattice([8, 8, 10]);
+        let LatticeSystem {
+            matrix: csr,
+            assembly: asm,
+            values,
+            directions,
+            body,
+        } = lattice_system([8, 8, 10]);
         let b: Vec<Real> = (0..asm.n)
             .map(|i| ((i * 7919) % 13) as Real - 6.0)
             .collect();
