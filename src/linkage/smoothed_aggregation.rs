@@ -418,7 +418,7 @@ fn chebyshev(
     }
 }
 
-/// λmax of `D⁻¹A` by 15 Lanczos steps on the similar symmetric `D^-½ A D^-½`: Lanczos finds
+/// λmax of `D⁻¹A` by 10 Lanczos steps on the similar symmetric `D^-½ A D^-½`: Lanczos finds
 /// the extreme eigenvalue far faster than power iteration, and an estimate that is too low
 /// would let the Chebyshev smoother amplify the highest modes.
 fn largest_eigenvalue(a: &SymmetricCsr, inverse_diagonal: &[Real]) -> Real {
@@ -434,7 +434,7 @@ fn largest_eigenvalue(a: &SymmetricCsr, inverse_diagonal: &[Real]) -> Real {
     let mut w = vec![0.0; n];
     let (mut alphas, mut betas) = (Vec::new(), Vec::new());
     let mut beta = 0.0;
-    for _ in 0..15.min(n) {
+    for _ in 0..10.min(n) {
         scaled
             .par_iter_mut()
             .zip(&v)
