@@ -20,6 +20,7 @@ pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
 pub use self::newton::NewtonEquilibrium;
 pub use self::smoothed_aggregation::{MultigridError, SmoothedAggregation};
+pub(crate) use self::step_state::post_process;
 pub use self::step_state::StepState;
 pub use self::symmetric_csr::{dot, Preconditioner, SymmetricCsr};
 

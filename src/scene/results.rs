@@ -95,6 +95,10 @@ pub struct StepSummary {
     pub max_penetration: Real,
     /// Wall time of the step, s (step 1 includes assembly and factorization).
     pub seconds: Real,
+    /// What the user should know about the step: penetration above the tolerance, a contact
+    /// set that did not settle (absent when there is nothing to say).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// Size of one body, as reported in `summary.json`.
@@ -130,6 +134,9 @@ pub struct PhaseSeconds {
     /// Drawing pictures (PNG frames, GIF) of the stored steps.
     #[serde(default)]
     pub drawing: Real,
+    /// Finding contacts (projecting nodes on obstacles and surfaces).
+    #[serde(default)]
+    pub contact_query: Real,
 }
 
 /// `summary.json`.

@@ -1,0 +1,275 @@
+//! Contact with rigid obstacles (issue 5): numbers that follow from the penalty law and from
+//! equilibrium. Tolerances are stated where they are used.
+
+use linkage::scene::{build_world, load_scene, Simulation, StepResult, StepSummary};
+use std::path::{Path, PathBuf};
+
+/// Solve every step of `world` in order; the results and summaries.
+fn run_all(world: &linkage::scene::World) -> Vec<(StepResult, StepSummary)> {
+    let sim = Simulation::new(world).expect("builds");
+    (0..=world.steps)
+        .map(|k| sim.step(k).expect("solves"))
+        .collect()
+}
+
+/// A scene folder holding `files` (name, text); returns the folder and the scene path.
+fn scene_with(files: &[(&str, &str)], scene: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    (dir, path)
+}
+
+/// Sum over the bodies of reactions, loads and contact forces (N), and the largest of them.
+fn balance(result: &StepResult) -> ([f64; 3], f64) {
+    let mut sum = [0.0; 3];
+    let mut largest: f64 = 0.0;
+    for b in &result.bodies {
+        let forces = b
+            .reactions
+            .iter()
+            .map(|r| &r.force)
+            .chain(b.loads.iter().map(|l| &l.force))
+            .chain(b.contacts.iter().map(|c| &c.force));
+        for f in forces {
+            let n = f.iter().map(|x| x * x).sum::<f64>().sqrt();
+            largest = largest.max(n);
+            for (k, x) in f.iter().enumerate() {
+                sum[k] += x;
+            }
+        }
+    }
+    (sum, largest)
+}
+
+const BAR_NODES: &str = "0 0\n0 1\n";
+const BAR_LINKS: &str = "1 2\n";
+
+fn bar_on_floor(contact: &str) -> String {
+    format!(
+        r#"
+name = "bar_on_floor"
+steps = 2
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "bar"
+nodes = "bar.nodes"
+links = "bar.links"
+# Held sideways only: vertically the floor alone holds it.
+[[bodies.supports]]
+nodes = [1, 2]
+fix = ["x"]
+[[bodies.loads]]
+nodes = [2]
+force = [0.0, -1000.0]
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+{contact}
+"#
+    )
+}
+
+/// A vertical bar standing on a floor, pushed down by F at its top and held by nothing else
+/// vertically: its foot sinks exactly F / k into the floor (k the penalty), the floor pushes
+/// back with F, and the bar carries −F. Checked with the default penalty (100 E A / L) and an
+/// explicit one, at both steps (F/2 and F).
+#[test]
+fn bar_pressed_onto_floor_sinks_force_over_penalty() {
+    for (contact, k) in [
+        ("", 100.0 * 200e9 * 1e-4 / 1.0),
+        ("[contact]\npenalty = 1e6\n", 1e6),
+    ] {
+        let (_dir, path) = scene_with(
+            &[("bar.nodes", BAR_NODES), ("bar.links", BAR_LINKS)],
+            &bar_on_floor(contact),
+        );
+        let world = load_scene(&path).unwrap();
+        for (result, summary) in run_all(&world).into_iter().skip(1) {
+            let f = 1000.0 * result.load_factor;
+            let bar = &result.bodies[0];
+            assert_eq!(
+                bar.contacts.len(),
+                1,
+                "only the foot touches: {:?}",
+                bar.contacts
+            );
+            let c = &bar.contacts[0];
+            assert_eq!((c.node, c.with.as_str()), (1, "floor"));
+            // Exactly F / k: to round-off of the solve (1e-9 relative).
+            assert!(
+                (c.depth - f / k).abs() <= 1e-9 * f / k,
+                "depth {} vs F/k {}",
+                c.depth,
+                f / k
+            );
+            assert!((c.force[1] - f).abs() <= 1e-9 * f && c.force[0].abs() <= 1e-9 * f);
+            assert!((bar.axial_forces[0] + f).abs() <= 1e-9 * f);
+            assert!((summary.max_penetration - f / k).abs() <= 1e-9 * f / k);
+            assert!(summary.contact_iterations >= 1);
+            // The foot's displacement is the penetration: the floor is at y = 0.
+            assert!((bar.displacements[0][1] + f / k).abs() <= 1e-9 * f / k);
+        }
+    }
+}
+
+/// A flat block pressed from above by a ball that travels 1 cm down into it: every contact
+/// force points along the radius from the ball's centre to the node (radial normals), away
+/// from the centre, and its size is the penalty times the depth.
+#[test]
+fn ball_obstacle_gives_radial_contact_forces() {
+    let scene = r#"
+name = "ball_press"
+steps = 2
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "block"
+rectangle = { width = 1.0, height = 0.2, cells = [40, 8] }
+[[bodies.supports]]
+on_line = { point = [0.0, 0.0], direction = [1.0, 0.0] }
+fix = ["x", "y"]
+[[obstacles]]
+name = "ball"
+shape = "ball"
+center = [0.5, 0.5]
+radius = 0.3
+travel = [0.0, -0.01]
+"#;
+    let world = build_world(scene, Path::new("ball_press.toml")).unwrap();
+    let k = 100.0 * mean_member_stiffness(&world.bodies[0]);
+    for (result, summary) in run_all(&world).into_iter().skip(1) {
+        let block = &result.bodies[0];
+        let center = [0.5, 0.5 - 0.01 * result.load_factor];
+        assert!(block.contacts.len() >= 3, "{:?}", block.contacts);
+        for c in &block.contacts {
+            let p = &block.positions[c.node - 1];
+            let r = [p[0] - center[0], p[1] - center[1]];
+            let rn = (r[0] * r[0] + r[1] * r[1]).sqrt();
+            let f = &c.force;
+            let fn_ = (f[0] * f[0] + f[1] * f[1]).sqrt();
+            // Parallel to the radius and outward, to round-off.
+            assert!(
+                (f[0] * r[1] - f[1] * r[0]).abs() <= 1e-9 * fn_ * rn,
+                "{c:?}"
+            );
+            assert!(f[0] * r[0] + f[1] * r[1] > 0.0, "{c:?}");
+            // |f| = k · depth and depth = R − |x − c|.
+            assert!((fn_ - k * c.depth).abs() <= 1e-9 * fn_);
+            assert!((c.depth - (0.3 - rn)).abs() <= 1e-12);
+        }
+        let (sum, largest) = balance(&result);
+        for s in sum {
+            assert!(s.abs() <= 1e-8 * largest, "out of balance {sum:?}");
+        }
+        assert!(summary.residual <= 1e-8, "{summary:?}");
+    }
+}
+
+fn mean_member_stiffness(body: &linkage::linkage::Body) -> f64 {
+    let sum: f64 = body
+        .members
+        .iter()
+        .enumerate()
+        .map(|(m, member)| {
+            let mat = &body.materials[member.material];
+            mat.youngs_modulus * mat.area / body.member_length(m)
+        })
+        .sum();
+    sum / body.members.len() as f64
+}
+
+/// The bundled disk_on_floor scene: at every step the supports' reactions, the loads and the
+/// floor's contact forces sum to zero (to 1e-8 of the largest), each contact force is the
+/// penalty times its depth along +y, and no node is deeper than the tolerance (1% of the mean
+/// member length).
+#[test]
+fn disk_on_floor_is_in_equilibrium() {
+    let world = load_scene(Path::new("scenes/disk_on_floor.toml")).unwrap();
+    let body = &world.bodies[0];
+    let k = 100.0 * mean_member_stiffness(body);
+    let mean_length: f64 = (0..body.members.len())
+        .map(|m| body.member_length(m))
+        .sum::<f64>()
+        / body.members.len() as f64;
+    let mut touched = 0;
+    for (result, summary) in run_all(&world) {
+        let (sum, largest) = balance(&result);
+        for s in sum {
+            assert!(
+                s.abs() <= 1e-8 * largest.max(1e-300),
+                "step {}: {sum:?}",
+                result.step
+            );
+        }
+        for c in &result.bodies[0].contacts {
+            assert!(c.force[0].abs() <= 1e-9 * c.force[1]);
+            assert!((c.force[1] - k * c.depth).abs() <= 1e-9 * c.force[1]);
+            assert!(c.depth <= 0.01 * mean_length);
+        }
+        touched = touched.max(result.bodies[0].contacts.len());
+        assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
+    }
+    assert!(
+        touched >= 3,
+        "the disk flattens onto several nodes: {touched}"
+    );
+}
+
+/// Obstacles are checked like everything else: the file, the line and what to do.
+#[test]
+fn bad_obstacles_are_reported_with_line() {
+    let base = r#"
+name = "s"
+[[materials]]
+name = "m"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "disk"
+disk = { radius = 0.1 }
+[[bodies.supports]]
+nodes = [1]
+fix = ["x", "y"]
+"#;
+    let cases = [
+        (
+            "[[obstacles]]\nname = \"disk\"\nshape = \"ball\"\ncenter = [0.0, 0.0]\nradius = 1.0\n",
+            "distinct names",
+        ),
+        (
+            "[[obstacles]]\nname = \"o\"\nshape = \"cone\"\n",
+            "shape = \"cone\"",
+        ),
+        (
+            "[[obstacles]]\nname = \"o\"\nshape = \"ball\"\ncenter = [0.0, 0.0, 1.0]\nradius = 1.0\n",
+            "3 components",
+        ),
+        (
+            "[[obstacles]]\nname = \"o\"\nshape = \"half_space\"\npoint = [0.0, 0.0]\nnormal = [0.0, 0.0]\n",
+            "zero vector",
+        ),
+        ("[contact]\npenalty = -1.0\n", "penalty = -1"),
+    ];
+    for (extra, expected) in cases {
+        let text = format!("{base}{extra}");
+        let err = build_world(&text, Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(expected), "{err}");
+        assert!(
+            err.starts_with("s.toml:1"),
+            "names the file and line: {err}"
+        );
+    }
+}
