@@ -273,3 +273,75 @@ fix = ["x", "y"]
         );
     }
 }
+
+/// The bundled two_disks scene: two equal disks pressed together by equal and opposite forces,
+/// held sideways by nothing but each other. At every loaded step the contact forces on each
+/// disk sum to minus its applied load (to 1e-6 relative) and are equal and opposite between the
+/// disks; no node is deeper than the tolerance (1% of the mean member length); the
+/// displacements are mirror images about x = 0 (to 1e-6 of the largest); the contact zone is
+/// centred on the line of centres (y = 0).
+#[test]
+fn two_disks_press_each_other_symmetrically() {
+    let world = load_scene(Path::new("scenes/two_disks.toml")).unwrap();
+    let body = &world.bodies[0];
+    let mean_length: f64 = (0..body.members.len())
+        .map(|m| body.member_length(m))
+        .sum::<f64>()
+        / body.members.len() as f64;
+    for (result, summary) in run_all(&world).into_iter().skip(1) {
+        let f = 400.0 * result.load_factor;
+        let [left, right] = [&result.bodies[0], &result.bodies[1]];
+        let sum = |b: &linkage::scene::BodyResult| {
+            b.contacts
+                .iter()
+                .fold([0.0, 0.0], |s, c| [s[0] + c.force[0], s[1] + c.force[1]])
+        };
+        let (l, r) = (sum(left), sum(right));
+        assert!(
+            (l[0] + f).abs() <= 1e-6 * f && l[1].abs() <= 1e-6 * f,
+            "left {l:?}, load {f}"
+        );
+        assert!(
+            (r[0] - f).abs() <= 1e-6 * f && r[1].abs() <= 1e-6 * f,
+            "right {r:?}"
+        );
+        assert!((l[0] + r[0]).abs() <= 1e-9 * f, "equal and opposite");
+        for c in left.contacts.iter().chain(&right.contacts) {
+            assert!(c.depth <= 0.01 * mean_length, "{c:?}");
+        }
+        assert!(summary.max_penetration <= 0.01 * mean_length);
+        // Mirror images: node i of the left disk at (x, y) has its twin at (−x, y).
+        let largest = left
+            .displacements
+            .iter()
+            .map(|u| u[0].hypot(u[1]))
+            .fold(0.0, f64::max);
+        let nodes_l = &world.bodies[0].nodes;
+        let nodes_r = &world.bodies[1].nodes;
+        for (i, p) in nodes_l.iter().enumerate() {
+            let j = nodes_r
+                .iter()
+                .position(|q| (q.x + p.x).abs() < 1e-12 && (q.y - p.y).abs() < 1e-12)
+                .expect("a mirror twin");
+            let (ul, ur) = (&left.displacements[i], &right.displacements[j]);
+            assert!(
+                (ul[0] + ur[0]).abs() <= 1e-6 * largest && (ul[1] - ur[1]).abs() <= 1e-6 * largest,
+                "node {}: {ul:?} vs twin {}: {ur:?}",
+                i + 1,
+                j + 1
+            );
+        }
+        // Centred on y = 0: the force-weighted mean height of the contact nodes.
+        let (mut moment, mut total) = (0.0, 0.0);
+        for c in &left.contacts {
+            let p = &left.positions[c.node - 1];
+            let size = c.force[0].hypot(c.force[1]);
+            moment += size * p[1];
+            total += size;
+        }
+        assert!(total > 0.0 && (moment / total).abs() <= 1e-9 * mean_length);
+        if result.step == world.steps {
+            assert!(left.contacts.len() >= 3, "a contact zone, not a point");
+        }
+    }
+}

@@ -10,8 +10,30 @@ pub struct ActiveContact {
     pub body: usize,
     /// The node, 0-based.
     pub node: usize,
-    /// The obstacle it presses on (index in the scene).
-    pub obstacle: usize,
+    /// What it presses on.
+    pub with: Target,
+}
+
+/// What a node presses on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Target {
+    /// An obstacle (index in the scene).
+    Obstacle(usize),
+    /// A boundary segment of a 2D body.
+    Segment {
+        /// The body (index in the scene).
+        body: usize,
+        /// The segment: from the i-th node of the body's boundary loop to the next.
+        segment: usize,
+    },
+    /// A boundary vertex of a 2D body, pressed along the mean normal of its two segments (a
+    /// node equally near both).
+    Vertex {
+        /// The body (index in the scene).
+        body: usize,
+        /// Position of the vertex in the body's boundary loop.
+        vertex: usize,
+    },
 }
 
 /// The active contacts, sorted: two sets compare equal when the same nodes touch the same

@@ -23,11 +23,13 @@ pub(crate) struct CoupledSystem {
 }
 
 impl CoupledSystem {
-    /// The block-diagonal pattern of `assemblies` (body order); `node_offsets[b]` is the first
-    /// global node of body b (the ordering keeps the DOFs of a node together).
+    /// The pattern of `assemblies` on the diagonal (body order) plus the entries `extra`
+    /// (global free DOF pairs, either order: contacts between bodies); `node_offsets[b]` is the
+    /// first global node of body b (the ordering keeps the DOFs of a node together).
     pub(crate) fn new(
         assemblies: &[&StiffnessAssembly],
         node_offsets: &[usize],
+        extra: &[(usize, usize)],
     ) -> Result<Self, CholeskyError> {
         let mut offsets = Vec::with_capacity(assemblies.len());
         let mut n = 0;
@@ -35,20 +37,46 @@ impl CoupledSystem {
             offsets.push(n);
             n += a.n;
         }
+        let mut columns: Vec<Vec<usize>> = Vec::with_capacity(n);
+        let mut groups = Vec::with_capacity(n);
+        for ((a, &offset), &node_offset) in assemblies.iter().zip(&offsets).zip(node_offsets) {
+            for c in 0..a.n {
+                columns.push(
+                    a.row_idx[a.col_ptr[c]..a.col_ptr[c + 1]]
+                        .iter()
+                        .map(|r| r + offset)
+                        .collect(),
+                );
+                groups.push(a.groups[c] + node_offset);
+            }
+        }
+        for &(r, c) in extra {
+            let (r, c) = (r.max(c), r.min(c));
+            if c < n && r < n {
+                columns[c].push(r);
+            }
+        }
         let mut col_ptr = Vec::with_capacity(n + 1);
         col_ptr.push(0);
         let mut row_idx = Vec::new();
-        let mut groups = Vec::with_capacity(n);
+        for mut rows in columns {
+            rows.sort_unstable();
+            rows.dedup();
+            row_idx.extend(rows);
+            col_ptr.push(row_idx.len());
+        }
         let mut places = Vec::with_capacity(assemblies.len());
-        for ((a, &offset), &node_offset) in assemblies.iter().zip(&offsets).zip(node_offsets) {
+        for (a, &offset) in assemblies.iter().zip(&offsets) {
             let mut place = Vec::with_capacity(a.nnz());
             for c in 0..a.n {
+                let gc = c + offset;
+                let rows = &row_idx[col_ptr[gc]..col_ptr[gc + 1]];
                 for &r in &a.row_idx[a.col_ptr[c]..a.col_ptr[c + 1]] {
-                    place.push(row_idx.len());
-                    row_idx.push(r + offset);
+                    let k = rows.binary_search(&(r + offset)).map_err(|_| {
+                        CholeskyError::InvalidInput("a body entry left the pattern".to_string())
+                    })?;
+                    place.push(col_ptr[gc] + k);
                 }
-                col_ptr.push(row_idx.len());
-                groups.push(a.groups[c] + node_offset);
             }
             places.push(place);
         }
@@ -71,6 +99,14 @@ impl CoupledSystem {
             places,
             cholesky,
         })
+    }
+
+    /// Whether entry (`r`, `c`) (either order) is in the pattern.
+    pub(crate) fn contains(&self, r: usize, c: usize) -> bool {
+        let (r, c) = (r.max(c), r.min(c));
+        self.row_idx[self.col_ptr[c]..self.col_ptr[c + 1]]
+            .binary_search(&r)
+            .is_ok()
     }
 
     /// Set the values to the bodies' tangents (`local[b]` in body b's assembly pattern).

@@ -1,6 +1,7 @@
 //! Contact between deformable bodies and rigid obstacles: obstacles held in rapier, penalty forces with their stiffness, and the settle loop.
 
-pub use self::contact_set::{ActiveContact, ContactSet, NodeContact};
+pub use self::boundary::boundary_loop;
+pub use self::contact_set::{ActiveContact, ContactSet, NodeContact, Target};
 pub use self::error::ContactError;
 pub use self::obstacle::{Obstacle, ObstacleShape};
 pub use self::obstacles::{ObstacleProjection, Obstacles};
@@ -8,6 +9,7 @@ pub use self::penalty::{default_penalty, penetration_tolerance, Penalty, PENALTY
 pub use self::settings::ContactSettings;
 pub use self::settle::{ContactSolver, ContactStep};
 
+mod boundary;
 mod contact_set;
 mod coupled_system;
 mod error;

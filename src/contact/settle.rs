@@ -9,15 +9,16 @@
 //! the set solved. A set seen before (the contact flips back and forth) ends the loop with a
 //! warning, as does running out of contact iterations.
 
+use crate::contact::boundary::boundary_loop;
 use crate::contact::coupled_system::CoupledSystem;
 use crate::contact::{
     default_penalty, penetration_tolerance, ActiveContact, ContactError, ContactSet,
-    ContactSettings, NodeContact, Obstacle, Obstacles, Penalty,
+    ContactSettings, NodeContact, Obstacle, Obstacles, Penalty, Target,
 };
 use crate::linkage::cholesky::CholeskyError;
 use crate::linkage::{
-    member_response, post_process, Body, DofMap, PathMethod, PhaseTimes, Schedule, SolveError,
-    StepState, StiffnessAssembly,
+    member_response, post_process, Body, Dimension, DofMap, PathMethod, PhaseTimes, Schedule,
+    SolveError, StepState, StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
@@ -28,8 +29,22 @@ use std::time::Instant;
 /// enough that the stabilised matrix is still the tangent to 9 digits, large enough to factor.
 pub const STABILISATION: Real = 1e-9;
 
-/// A contact evaluated at the current displacements: depth (m) and outward normal.
-type Evaluated = (ActiveContact, Real, Option<Vector3<Real>>);
+/// A deformed boundary loop and its bounding box `[x_min, y_min, x_max, y_max]`, m.
+type Polygon = (Vec<Vector3<Real>>, [Real; 4]);
+
+/// A contact evaluated at the current displacements.
+struct Evaluated {
+    contact: ActiveContact,
+    /// Penetration, m (negative: the node has come out).
+    depth: Real,
+    /// Outward unit normal of the surface pressed on.
+    normal: Option<Vector3<Real>>,
+    /// Penalty stiffness, N/m.
+    penalty: Penalty,
+    /// The nodes the force acts on, as (body, node, weight): the pressing node with 1, a
+    /// segment's end nodes with minus their barycentric weights (momentum is conserved).
+    nodes: Vec<(usize, usize, Real)>,
+}
 
 /// One body's part of the coupled solve.
 struct BodyPart {
@@ -67,6 +82,12 @@ pub struct ContactStep {
 /// All the bodies of a scene with contact, solved together step by step.
 pub struct ContactSolver {
     parts: Vec<BodyPart>,
+    /// First global node of each body.
+    node_offsets: Vec<usize>,
+    /// Contact surface of each body (2D: its outer boundary), `None` if it has none.
+    surfaces: Vec<Option<Surface>>,
+    /// Entries between bodies added to the coupled pattern so far (global free DOFs, r ≥ c).
+    coupling: Vec<(usize, usize)>,
     obstacles: Obstacles,
     system: CoupledSystem,
     settings: ContactSettings,
@@ -125,15 +146,19 @@ impl ContactSolver {
         let assembly_time = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let assemblies: Vec<&StiffnessAssembly> = parts.iter().map(|p| &p.assembly).collect();
-        let system = CoupledSystem::new(&assemblies, &node_offsets)
+        let system = CoupledSystem::new(&assemblies, &node_offsets, &[])
             .map_err(|e| ContactError::Factorization(e.to_string()))?;
         let times = PhaseTimes {
             assembly: assembly_time,
             symbolic: t.elapsed().as_secs_f64(),
             ..Default::default()
         };
+        let surfaces = bodies.iter().map(Surface::of).collect();
         Ok(ContactSolver {
             parts,
+            node_offsets,
+            surfaces,
+            coupling: Vec::new(),
             obstacles: Obstacles::new(obstacles),
             system,
             settings,
@@ -143,7 +168,7 @@ impl ContactSolver {
             move_cap: bodies
                 .iter()
                 .filter(|b| !b.members.is_empty())
-                .map(|b| 100.0 * penetration_tolerance(b))
+                .map(|b| 10.0 * penetration_tolerance(b))
                 .fold(Real::INFINITY, Real::min),
             unheld: 0,
             times,
@@ -237,25 +262,105 @@ impl ContactSolver {
         self.finish(bodies, &forces, &offsets, step, out)
     }
 
-    /// The contact force on each body DOF of `body` (index `b`) from the contacts of `set`, N;
-    /// also each contact's (depth, normal).
+    /// The contact force on each body DOF of every body from the contacts of `set`, N; and
+    /// each contact evaluated.
     fn contact_forces(
         &mut self,
-        b: usize,
-        body: &Body,
+        bodies: &[Body],
         set: &ContactSet,
         offsets: &[Vector3<Real>],
-    ) -> (Vec<Real>, Vec<Evaluated>) {
-        let part = &self.parts[b];
-        let d = part.dofs.dofs_per_node;
-        let mut f = vec![0.0; part.u.len()];
-        let mut list = Vec::new();
-        for c in set.contacts.iter().filter(|c| c.body == b) {
-            let x = body.nodes[c.node] + node_vector(&part.u, d, c.node);
-            let Some(p) = self.obstacles.project(c.obstacle, &x, &offsets[c.obstacle]) else {
-                continue;
+    ) -> (Vec<Vec<Real>>, Vec<Evaluated>) {
+        let mut f: Vec<Vec<Real>> = self.parts.iter().map(|p| vec![0.0; p.u.len()]).collect();
+        let mut list = Vec::with_capacity(set.len());
+        for c in &set.contacts {
+            let x = self.position(bodies, c.body, c.node);
+            let (depth, normal, nodes, penalty) = match c.with {
+                Target::Obstacle(o) => {
+                    let Some(p) = self.obstacles.project(o, &x, &offsets[o]) else {
+                        continue;
+                    };
+                    (
+                        p.depth,
+                        p.normal,
+                        vec![(c.body, c.node, 1.0)],
+                        self.parts[c.body].penalty,
+                    )
+                }
+                Target::Vertex { body, vertex } => {
+                    let Some(surface) = self.surfaces[body].as_ref() else {
+                        continue;
+                    };
+                    let (before, v) = surface.segment(surface.previous(vertex));
+                    let (_, after) = surface.segment(vertex);
+                    let corner = self.position(bodies, body, v);
+                    let n = segment_projection(&x, &self.position(bodies, body, before), &corner)
+                        .normal
+                        .unwrap_or_default()
+                        + segment_projection(&x, &corner, &self.position(bodies, body, after))
+                            .normal
+                            .unwrap_or_default();
+                    let normal = (n.norm() > 0.0).then(|| n.normalize());
+                    let depth = normal.map_or(0.0, |n| (corner - x).dot(&n));
+                    let penalty = Penalty {
+                        stiffness: self.parts[c.body]
+                            .penalty
+                            .stiffness
+                            .min(self.parts[body].penalty.stiffness),
+                    };
+                    (
+                        depth,
+                        normal,
+                        vec![(c.body, c.node, 1.0), (body, v, -1.0)],
+                        penalty,
+                    )
+                }
+                Target::Segment { body, segment } => {
+                    let Some(surface) = self.surfaces[body].as_ref() else {
+                        continue;
+                    };
+                    let (a, b) = surface.segment(segment);
+                    let pa = self.position(bodies, body, a);
+                    let pb = self.position(bodies, body, b);
+                    let mut s = segment_projection(&x, &pa, &pb);
+                    // Nearest to an end: that vertex is pressed, along the mean of the normals of
+                    // its two segments (which of the two was found does not matter then).
+                    let vertex = if s.t <= 0.0 {
+                        let (before, _) = surface.segment(surface.previous(segment));
+                        Some((pa, self.position(bodies, body, before), pa, pb))
+                    } else if s.t >= 1.0 {
+                        let (_, after) = surface.segment(surface.next(segment));
+                        Some((pb, pa, pb, self.position(bodies, body, after)))
+                    } else {
+                        None
+                    };
+                    if let Some((corner, p0, p1, p2)) = vertex {
+                        let n = segment_projection(&x, &p0, &p1).normal.unwrap_or_default()
+                            + segment_projection(&x, &p1, &p2).normal.unwrap_or_default();
+                        if n.norm() > 0.0 {
+                            let n = n.normalize();
+                            s.normal = Some(n);
+                            s.depth = (corner - x).dot(&n);
+                        }
+                    }
+                    let penalty = Penalty {
+                        stiffness: self.parts[c.body]
+                            .penalty
+                            .stiffness
+                            .min(self.parts[body].penalty.stiffness),
+                    };
+                    (
+                        s.depth,
+                        s.normal,
+                        vec![
+                            (c.body, c.node, 1.0),
+                            (body, a, -(1.0 - s.t)),
+                            (body, b, -s.t),
+                        ],
+                        penalty,
+                    )
+                }
             };
-            let normal = match p.normal {
+            let normal = match normal {
                 Some(n) => {
                     self.normals.insert(*c, n);
                     Some(n)
@@ -263,14 +368,29 @@ impl ContactSolver {
                 None => self.normals.get(c).copied(),
             };
             if let Some(n) = normal {
-                let force = part.penalty.force(p.depth, &n);
-                for k in 0..d {
-                    f[c.node * d + k] += force[k];
+                let force = penalty.force(depth, &n);
+                for &(b, node, w) in &nodes {
+                    let d = self.parts[b].dofs.dofs_per_node;
+                    for k in 0..d {
+                        f[b][node * d + k] += w * force[k];
+                    }
                 }
             }
-            list.push((*c, p.depth, normal));
+            list.push(Evaluated {
+                contact: *c,
+                depth,
+                normal,
+                penalty,
+                nodes,
+            });
         }
         (f, list)
+    }
+
+    /// The deformed position of `node` of body `b`, m.
+    fn position(&self, bodies: &[Body], b: usize, node: usize) -> Vector3<Real> {
+        let part = &self.parts[b];
+        bodies[b].nodes[node] + node_vector(&part.u, part.dofs.dofs_per_node, node)
     }
 
     /// The out-of-balance force `F + f_c − f_int` at the free DOFs of all bodies (global
@@ -285,8 +405,8 @@ impl ContactSolver {
     ) -> (Vec<Real>, Real) {
         let mut r = vec![0.0; self.system.n];
         let (mut applied, mut reacted, mut contact) = (0.0, 0.0, 0.0);
-        for (b, body) in bodies.iter().enumerate() {
-            let (fc, _) = self.contact_forces(b, body, set, offsets);
+        let (all, _) = self.contact_forces(bodies, set, offsets);
+        for ((b, body), fc) in bodies.iter().enumerate().zip(all) {
             let part = &self.parts[b];
             let internal = internal_forces(body, part.dofs.dofs_per_node, &part.u);
             let offset = self.system.offsets[b];
@@ -368,15 +488,15 @@ impl ContactSolver {
             self.times.solve += t.elapsed().as_secs_f64();
             iterations += 1;
             if stabilised {
+                // A body flying toward its contacts: move it at most `move_cap`, then look for
+                // contacts again. A smaller correction (the singular direction is not loaded,
+                // as the common sideways motion of two bodies pressed together) is a Newton step.
                 let largest = self.largest_move(&delta);
-                let s = if largest > self.move_cap {
-                    self.move_cap / largest
-                } else {
-                    1.0
-                };
-                let base: Vec<Vec<Real>> = self.parts.iter().map(|p| p.u.clone()).collect();
-                self.move_free(&base, &delta, s);
-                return Ok((iterations, false));
+                if largest > self.move_cap {
+                    let base: Vec<Vec<Real>> = self.parts.iter().map(|p| p.u.clone()).collect();
+                    self.move_free(&base, &delta, self.move_cap / largest);
+                    return Ok((iterations, false));
+                }
             }
             last_step = self.line_search(bodies, set, forces, offsets, &delta, rnorm);
         }
@@ -392,6 +512,7 @@ impl ContactSolver {
         offsets: &[Vector3<Real>],
     ) -> Result<bool, ContactError> {
         let t = Instant::now();
+        self.couple(bodies, set, offsets)?;
         for (part, body) in self.parts.iter_mut().zip(bodies) {
             let d = part.dofs.dofs_per_node;
             let u = &part.u;
@@ -407,21 +528,23 @@ impl ContactSolver {
         for (part, local) in self.parts.iter_mut().zip(locals) {
             part.local = local;
         }
-        for (b, body) in bodies.iter().enumerate() {
-            let (_, list) = self.contact_forces(b, body, set, offsets);
-            let part = &self.parts[b];
-            let d = part.dofs.dofs_per_node;
-            let offset = self.system.offsets[b];
-            for (c, _, normal) in list {
-                let Some(n) = normal else { continue };
-                let k = part.penalty.stiffness(&n);
-                for p in 0..d {
-                    for q in 0..d {
-                        if let (Some(i), Some(j)) = (
-                            part.dofs.free_index(c.node, p),
-                            part.dofs.free_index(c.node, q),
-                        ) {
-                            self.system.add(offset + i, offset + j, k[(p, q)]);
+        let (_, list) = self.contact_forces(bodies, set, offsets);
+        for e in &list {
+            let Some(n) = e.normal else { continue };
+            let k = e.penalty.stiffness(&n);
+            for &(b1, node1, w1) in &e.nodes {
+                for &(b2, node2, w2) in &e.nodes {
+                    let (p1, p2) = (&self.parts[b1], &self.parts[b2]);
+                    let d = p1.dofs.dofs_per_node.min(p2.dofs.dofs_per_node);
+                    for p in 0..d {
+                        for q in 0..d {
+                            if let (Some(i), Some(j)) =
+                                (p1.dofs.free_index(node1, p), p2.dofs.free_index(node2, q))
+                            {
+                                let (r, c) =
+                                    (self.system.offsets[b1] + i, self.system.offsets[b2] + j);
+                                self.system.add(r, c, w1 * w2 * k[(p, q)]);
+                            }
                         }
                     }
                 }
@@ -445,6 +568,51 @@ impl ContactSolver {
             Ok(()) => Ok(stabilised),
             Err(other) => Err(ContactError::Factorization(other.to_string())),
         }
+    }
+
+    /// Make the coupled pattern hold the entries between the nodes of every contact of `set`
+    /// (new contacts between bodies add entries: the pattern is rebuilt and analyzed again,
+    /// keeping every entry added before so that a contact coming back costs nothing).
+    fn couple(
+        &mut self,
+        bodies: &[Body],
+        set: &ContactSet,
+        offsets: &[Vector3<Real>],
+    ) -> Result<(), ContactError> {
+        let (_, list) = self.contact_forces(bodies, set, offsets);
+        let mut missing = Vec::new();
+        for e in list.iter().filter(|e| e.nodes.len() > 1) {
+            for &(b1, n1, _) in &e.nodes {
+                for &(b2, n2, _) in &e.nodes {
+                    let (p1, p2) = (&self.parts[b1], &self.parts[b2]);
+                    for p in 0..p1.dofs.dofs_per_node {
+                        for q in 0..p2.dofs.dofs_per_node {
+                            if let (Some(i), Some(j)) =
+                                (p1.dofs.free_index(n1, p), p2.dofs.free_index(n2, q))
+                            {
+                                let (r, c) =
+                                    (self.system.offsets[b1] + i, self.system.offsets[b2] + j);
+                                if !self.system.contains(r, c) {
+                                    missing.push((r.max(c), r.min(c)));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if missing.is_empty() {
+            return Ok(());
+        }
+        let t = Instant::now();
+        self.coupling.extend(missing);
+        self.coupling.sort_unstable();
+        self.coupling.dedup();
+        let assemblies: Vec<&StiffnessAssembly> = self.parts.iter().map(|p| &p.assembly).collect();
+        self.system = CoupledSystem::new(&assemblies, &self.node_offsets, &self.coupling)
+            .map_err(|e| ContactError::Factorization(e.to_string()))?;
+        self.times.symbolic += t.elapsed().as_secs_f64();
+        Ok(())
     }
 
     /// The largest nodal length of a correction `delta` (global free DOFs), m.
@@ -509,31 +677,117 @@ impl ContactSolver {
         }
     }
 
-    /// Every node inside an obstacle, with the obstacle it is deepest in.
+    /// Every node inside an obstacle or (2D) inside another body, with what it is deepest in.
     fn query(&self, bodies: &[Body], offsets: &[Vector3<Real>]) -> ContactSet {
+        // Deformed boundary polygons and their bounding boxes (the broad phase).
+        let polygons: Vec<Option<Polygon>> = self
+            .surfaces
+            .iter()
+            .enumerate()
+            .map(|(b, s)| {
+                s.as_ref().map(|s| {
+                    let points: Vec<Vector3<Real>> = s
+                        .nodes
+                        .iter()
+                        .map(|&n| self.position(bodies, b, n))
+                        .collect();
+                    let mut bounds = [
+                        Real::INFINITY,
+                        Real::INFINITY,
+                        -Real::INFINITY,
+                        -Real::INFINITY,
+                    ];
+                    for p in &points {
+                        bounds = [
+                            bounds[0].min(p.x),
+                            bounds[1].min(p.y),
+                            bounds[2].max(p.x),
+                            bounds[3].max(p.y),
+                        ];
+                    }
+                    (points, bounds)
+                })
+            })
+            .collect();
         let mut found = Vec::new();
-        for (b, (part, body)) in self.parts.iter().zip(bodies).enumerate() {
-            let d = part.dofs.dofs_per_node;
-            for (node, x0) in body.nodes.iter().enumerate() {
-                let x = x0 + node_vector(&part.u, d, node);
-                let mut deepest: Option<(usize, Real)> = None;
+        for (b, body) in bodies.iter().enumerate() {
+            for node in 0..body.nodes.len() {
+                let x = self.position(bodies, b, node);
+                let mut deepest: Option<(Target, Real)> = None;
+                let mut consider = |target: Target, depth: Real| {
+                    if depth > 0.0 && deepest.is_none_or(|(_, d)| depth > d) {
+                        deepest = Some((target, depth));
+                    }
+                };
                 for (o, offset) in offsets.iter().enumerate() {
                     if let Some(p) = self.obstacles.project(o, &x, offset) {
-                        if p.depth > 0.0 && deepest.is_none_or(|(_, depth)| p.depth > depth) {
-                            deepest = Some((o, p.depth));
-                        }
+                        consider(Target::Obstacle(o), p.depth);
                     }
                 }
-                if let Some((obstacle, _)) = deepest {
+                for (other, polygon) in polygons.iter().enumerate() {
+                    let Some((points, bounds)) = polygon else {
+                        continue;
+                    };
+                    if other == b
+                        || x.x < bounds[0]
+                        || x.y < bounds[1]
+                        || x.x > bounds[2]
+                        || x.y > bounds[3]
+                        || !inside_polygon(&x, points)
+                    {
+                        continue;
+                    }
+                    let distances: Vec<Real> = (0..points.len())
+                        .map(|i| {
+                            segment_projection(&x, &points[i], &points[(i + 1) % points.len()])
+                                .distance
+                        })
+                        .collect();
+                    let Some(i) =
+                        (0..distances.len()).min_by(|&i, &j| distances[i].total_cmp(&distances[j]))
+                    else {
+                        continue;
+                    };
+                    // Equally near the segments on both sides of a vertex (a node on a symmetry
+                    // line): press on the vertex, so that neither segment is favoured.
+                    let n = points.len();
+                    let tie = |j: usize| (distances[j] - distances[i]).abs() <= 1e-9 * distances[i];
+                    let target = if tie((i + n - 1) % n) {
+                        Target::Vertex {
+                            body: other,
+                            vertex: i,
+                        }
+                    } else if tie((i + 1) % n) {
+                        Target::Vertex {
+                            body: other,
+                            vertex: (i + 1) % n,
+                        }
+                    } else {
+                        Target::Segment {
+                            body: other,
+                            segment: i,
+                        }
+                    };
+                    consider(target, distances[i]);
+                }
+                if let Some((with, _)) = deepest {
                     found.push(ActiveContact {
                         body: b,
                         node,
-                        obstacle,
+                        with,
                     });
                 }
             }
         }
         ContactSet::new(found)
+    }
+
+    /// The name of what a contact touches.
+    fn target_name<'a>(&'a self, bodies: &'a [Body], with: Target) -> &'a str {
+        match with {
+            Target::Obstacle(o) => self.obstacles.name(o),
+            Target::Segment { body, .. } | Target::Vertex { body, .. } => &bodies[body].name,
+        }
     }
 
     /// States, contacts and penetration of the settled step.
@@ -546,8 +800,48 @@ impl ContactSolver {
         mut out: ContactStep,
     ) -> Result<ContactStep, ContactError> {
         let set = self.active.clone();
-        for (b, body) in bodies.iter().enumerate() {
-            let (fc, list) = self.contact_forces(b, body, &set, offsets);
+        let (all, list) = self.contact_forces(bodies, &set, offsets);
+        // Per body, per node touched: (what it touches, deepest depth, force received).
+        let mut touched: Vec<Vec<NodeContact>> = vec![Vec::new(); bodies.len()];
+        for e in &list {
+            let name = self.target_name(bodies, e.contact.with).to_string();
+            let force = e
+                .normal
+                .map_or(Vector3::zeros(), |n| e.penalty.force(e.depth, &n));
+            out.max_penetration = out.max_penetration.max(e.depth);
+            let part = &self.parts[e.contact.body];
+            if e.depth > part.tolerance {
+                out.warnings.push(format!(
+                    "step {step}: node {} of body '{}' is {:.3e} m inside '{name}' (tolerance {:.3e} m): raise [contact] penalty",
+                    e.contact.node + 1,
+                    bodies[e.contact.body].name,
+                    e.depth,
+                    part.tolerance
+                ));
+            }
+            for (k, &(b, node, w)) in e.nodes.iter().enumerate() {
+                // The pressing node touches the target; a surface node touches the pressing body.
+                let (with, depth) = if k == 0 {
+                    (name.clone(), e.depth.max(0.0))
+                } else {
+                    (bodies[e.contact.body].name.clone(), 0.0)
+                };
+                let list = &mut touched[b];
+                match list.iter_mut().find(|t| t.node == node && t.with == with) {
+                    Some(t) => {
+                        t.depth = t.depth.max(depth);
+                        t.force += force * w;
+                    }
+                    None => list.push(NodeContact {
+                        node,
+                        with,
+                        depth,
+                        force: force * w,
+                    }),
+                }
+            }
+        }
+        for ((b, body), fc) in bodies.iter().enumerate().zip(all) {
             let part = &self.parts[b];
             let d = part.dofs.dofs_per_node;
             let mut internal = internal_forces(body, d, &part.u);
@@ -583,35 +877,100 @@ impl ContactSolver {
             {
                 return Err(ContactError::NotFinite { step });
             }
-            let mut contacts = Vec::with_capacity(list.len());
-            for (c, depth, normal) in list {
-                let force = normal.map_or(Vector3::zeros(), |n| part.penalty.force(depth, &n));
-                let mut force = force;
+            let mut contacts = std::mem::take(&mut touched[b]);
+            for c in &mut contacts {
                 for k in d..3 {
-                    force[k] = 0.0;
+                    c.force[k] = 0.0;
                 }
-                out.max_penetration = out.max_penetration.max(depth);
-                if depth > part.tolerance {
-                    out.warnings.push(format!(
-                        "step {step}: node {} of body '{}' is {depth:.3e} m inside obstacle '{}' (tolerance {:.3e} m): raise [contact] penalty",
-                        c.node + 1,
-                        body.name,
-                        self.obstacles.name(c.obstacle),
-                        part.tolerance
-                    ));
-                }
-                contacts.push(NodeContact {
-                    node: c.node,
-                    with: self.obstacles.name(c.obstacle).to_string(),
-                    depth: depth.max(0.0),
-                    force,
-                });
             }
+            contacts.sort_by(|a, b| a.node.cmp(&b.node).then(a.with.cmp(&b.with)));
             out.states.push(state);
             out.contacts.push(contacts);
         }
         Ok(out)
     }
+}
+
+/// A contact surface: the closed loop of boundary nodes of a 2D body, counter-clockwise.
+struct Surface {
+    nodes: Vec<usize>,
+}
+
+impl Surface {
+    /// The boundary of a 2D body; `None` for a 3D body or a boundary that cannot be traced.
+    fn of(body: &Body) -> Option<Surface> {
+        if body.dimension != Dimension::Two {
+            return None;
+        }
+        boundary_loop(body).map(|nodes| Surface { nodes })
+    }
+
+    /// The segment before segment `i` in the loop.
+    fn previous(&self, i: usize) -> usize {
+        (i + self.nodes.len() - 1) % self.nodes.len()
+    }
+
+    /// The segment after segment `i` in the loop.
+    fn next(&self, i: usize) -> usize {
+        (i + 1) % self.nodes.len()
+    }
+
+    /// The end nodes of segment `i`.
+    fn segment(&self, i: usize) -> (usize, usize) {
+        (self.nodes[i], self.nodes[(i + 1) % self.nodes.len()])
+    }
+}
+
+/// A point against a boundary segment from `a` to `b` of a counter-clockwise loop.
+struct SegmentProjection {
+    /// Barycentric weight of `b` of the nearest point (0 at a, 1 at b).
+    t: Real,
+    /// Distance to the nearest point, m.
+    distance: Real,
+    /// Depth behind the segment's line along its outward normal, m (negative in front).
+    depth: Real,
+    /// Outward unit normal (to the right of a → b).
+    normal: Option<Vector3<Real>>,
+}
+
+/// Project `x` on the segment `a`–`b` (z = 0).
+fn segment_projection(
+    x: &Vector3<Real>,
+    a: &Vector3<Real>,
+    b: &Vector3<Real>,
+) -> SegmentProjection {
+    let e = b - a;
+    let length2 = e.norm_squared();
+    let t = if length2 > 0.0 {
+        ((x - a).dot(&e) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let nearest = a + e * t;
+    let normal = if length2 > 0.0 {
+        Some(Vector3::new(e.y, -e.x, 0.0) / length2.sqrt())
+    } else {
+        None
+    };
+    SegmentProjection {
+        t,
+        distance: (x - nearest).norm(),
+        depth: normal.map_or(0.0, |n| (nearest - x).dot(&n)),
+        normal,
+    }
+}
+
+/// Whether `x` lies inside the closed polygon `points` (even–odd rule, z ignored).
+fn inside_polygon(x: &Vector3<Real>, points: &[Vector3<Real>]) -> bool {
+    let mut inside = false;
+    let n = points.len();
+    for i in 0..n {
+        let (p, q) = (points[i], points[(i + n - 1) % n]);
+        if (p.y > x.y) != (q.y > x.y) && x.x < (q.x - p.x) * (x.y - p.y) / (q.y - p.y) + p.x {
+            inside = !inside;
+        }
+    }
+    inside
 }
 
 fn node_vector(u: &[Real], d: usize, node: usize) -> Vector3<Real> {

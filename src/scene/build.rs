@@ -355,6 +355,10 @@ fn build_body(
             "patches are for 3D bodies; this body's nodes have 2 coordinates".to_string(),
         ));
     }
+    if let Some(offset) = &spec.offset {
+        let shift = vector(offset, body.dimension, "offset").map_err(&here)?;
+        body.nodes.iter_mut().for_each(|p| *p += shift);
+    }
 
     let schedule = |s: &Option<Vec<f64>>| -> Result<Schedule, String> {
         match s {

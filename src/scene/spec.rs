@@ -123,6 +123,8 @@ pub struct BodySpec {
     pub cylindrical_shell: Option<ShellSpec>,
     /// Generated 3D box lattice.
     pub box_lattice: Option<LatticeSpec>,
+    /// Translation of the body's nodes (from files or a generator), m: places bodies in a scene.
+    pub offset: Option<Vec<Real>>,
     /// Supports.
     #[serde(default)]
     pub supports: Vec<Spanned<SupportSpec>>,
