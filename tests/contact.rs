@@ -345,3 +345,44 @@ fn two_disks_press_each_other_symmetrically() {
         }
     }
 }
+
+/// shell_on_block and its moving variant: at every step the support reactions, the applied
+/// force and the block's contact forces balance (to 1e-8 of the largest), and every contact
+/// node lies on the block's top face (its y within the tolerance, 1% of the mean member length,
+/// of the face, which rises with the block's travel in the moving variant).
+#[test]
+fn shell_on_block_balances_and_rests_on_the_face() {
+    for (scene, top, rise) in [
+        ("scenes/shell_on_block.toml", -0.2502, 0.0),
+        ("scenes/shell_on_block_moving.toml", -0.25, 0.02),
+    ] {
+        let world = load_scene(Path::new(scene)).unwrap();
+        let body = &world.bodies[0];
+        let tolerance = 0.01
+            * (0..body.members.len())
+                .map(|m| body.member_length(m))
+                .sum::<f64>()
+            / body.members.len() as f64;
+        let mut touched = false;
+        for (result, summary) in run_all(&world) {
+            let (sum, largest) = balance(&result);
+            for s in sum {
+                assert!(s.abs() <= 1e-8 * largest.max(1e-300), "{scene}: {sum:?}");
+            }
+            let face = top + rise * result.load_factor;
+            let shell = &result.bodies[0];
+            for c in &shell.contacts {
+                let y = shell.positions[c.node - 1][1];
+                assert!(
+                    (y - face).abs() <= tolerance,
+                    "{scene}: node {} at {y}",
+                    c.node
+                );
+                assert!(c.force[1] > 0.0 && c.force[0] == 0.0 && c.force[2] == 0.0);
+                touched = true;
+            }
+            assert!(summary.residual <= 1e-8, "{scene}: {summary:?}");
+        }
+        assert!(touched, "{scene}: the shell reaches the block");
+    }
+}

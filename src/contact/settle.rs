@@ -46,6 +46,13 @@ struct Evaluated {
     nodes: Vec<(usize, usize, Real)>,
 }
 
+/// A node counts as inside a surface when it is deeper than this fraction of the penetration
+/// tolerance (1e-9 of 1% of a member: round-off does not make contacts).
+pub const MIN_DEPTH: Real = 1e-9;
+
+/// See [`ContactSolver::force_floor`].
+pub const FORCE_FLOOR: Real = 1e-10;
+
 /// One body's part of the coupled solve.
 struct BodyPart {
     dofs: DofMap,
@@ -174,6 +181,29 @@ impl ContactSolver {
             times,
             query_seconds: 0.0,
         })
+    }
+
+    /// The smallest force scale a residual is measured against, N: `FORCE_FLOOR` times the
+    /// smallest penalty times the smallest tolerance (a force of the order of a member's
+    /// `E A`). Where nothing is loaded (step 0, a node touching a surface at a depth of
+    /// round-off) the residual is then round-off over a real force, not round-off over round-off.
+    fn force_floor(&self) -> Real {
+        let k = self
+            .parts
+            .iter()
+            .map(|p| p.penalty.stiffness)
+            .fold(Real::INFINITY, Real::min);
+        let tolerance = self
+            .parts
+            .iter()
+            .map(|p| p.tolerance)
+            .fold(Real::INFINITY, Real::min);
+        let floor = FORCE_FLOOR * k * tolerance;
+        if floor.is_finite() {
+            floor
+        } else {
+            0.0
+        }
     }
 
     /// Rows of the coupled system of all bodies (their free DOFs).
@@ -419,7 +449,8 @@ impl ContactSolver {
             applied += forces[b].iter().map(|f| f * f).sum::<Real>();
             contact += fc.iter().map(|f| f * f).sum::<Real>();
         }
-        (r, applied.sqrt().max(reacted.sqrt()).max(contact.sqrt()))
+        let scale = applied.sqrt().max(reacted.sqrt()).max(contact.sqrt());
+        (r, scale.max(self.force_floor()))
     }
 
     /// Newton on all bodies with the contact set fixed. Returns the iterations and whether
@@ -438,7 +469,7 @@ impl ContactSolver {
             .iter()
             .map(|b| b.newton.tolerance)
             .fold(Real::INFINITY, Real::min)
-            .min(1e-8);
+            .min(1e-10);
         let max_iterations = bodies
             .iter()
             .map(|b| b.newton.max_iterations)
@@ -709,13 +740,21 @@ impl ContactSolver {
                 })
             })
             .collect();
+        // A node on a surface at a depth of round-off (a rim node on a floor through it) does
+        // not count: it would flip in and out of the set.
+        let min_depth = MIN_DEPTH
+            * self
+                .parts
+                .iter()
+                .map(|p| p.tolerance)
+                .fold(Real::INFINITY, Real::min);
         let mut found = Vec::new();
         for (b, body) in bodies.iter().enumerate() {
             for node in 0..body.nodes.len() {
                 let x = self.position(bodies, b, node);
                 let mut deepest: Option<(Target, Real)> = None;
                 let mut consider = |target: Target, depth: Real| {
-                    if depth > 0.0 && deepest.is_none_or(|(_, d)| depth > d) {
+                    if depth > min_depth && deepest.is_none_or(|(_, d)| depth > d) {
                         deepest = Some((target, depth));
                     }
                 };
@@ -855,20 +894,31 @@ impl ContactSolver {
             let mut state = post_process(body, &part.dofs, &part.u, &forces[b], &internal, members);
             state.iterations = out.newton_iterations;
             // Relative to the contact forces too: a body held by contact alone has no reactions.
-            let contact_norm = norm(&fc);
-            if contact_norm > 0.0 && state.residual.is_finite() {
-                let applied = norm(&forces[b]);
-                let reacted = part
-                    .dofs
-                    .supported
-                    .iter()
-                    .map(|&dof| (internal[dof] - forces[b][dof]).powi(2))
-                    .sum::<Real>()
-                    .sqrt();
-                let scale = applied.max(reacted);
-                let out_of_balance = state.residual * scale;
-                state.residual = out_of_balance / scale.max(contact_norm);
-            }
+            // Relative to the largest of applied, reaction and contact forces (a body held by
+            // contact alone has no reactions), and at least the force floor.
+            let out_of_balance = part
+                .dofs
+                .free
+                .iter()
+                .map(|&dof| (internal[dof] - forces[b][dof]).powi(2))
+                .sum::<Real>()
+                .sqrt();
+            let reacted = part
+                .dofs
+                .supported
+                .iter()
+                .map(|&dof| (internal[dof] - forces[b][dof]).powi(2))
+                .sum::<Real>()
+                .sqrt();
+            let scale = norm(&forces[b])
+                .max(reacted)
+                .max(norm(&fc))
+                .max(self.force_floor());
+            state.residual = if scale > 0.0 {
+                out_of_balance / scale
+            } else {
+                out_of_balance
+            };
             if !state.residual.is_finite()
                 || state
                     .displacements
