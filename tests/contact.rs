@@ -306,6 +306,18 @@ fn two_disks_press_each_other_symmetrically() {
             "right {r:?}"
         );
         assert!((l[0] + r[0]).abs() <= 1e-9 * f, "equal and opposite");
+        // The summary's total per pair says the same.
+        let pair = |body: &str| {
+            summary
+                .contact_forces
+                .iter()
+                .find(|p| p.body == body)
+                .unwrap_or_else(|| panic!("a total for {body}: {:?}", summary.contact_forces))
+                .clone()
+        };
+        let (pl, pr) = (pair("left"), pair("right"));
+        assert_eq!((pl.with.as_str(), pr.with.as_str()), ("right", "left"));
+        assert!((pl.force[0] - l[0]).abs() <= 1e-9 * f && (pr.force[0] - r[0]).abs() <= 1e-9 * f);
         for c in left.contacts.iter().chain(&right.contacts) {
             assert!(c.depth <= 0.01 * mean_length, "{c:?}");
         }

@@ -84,6 +84,9 @@ pub struct ContactStep {
     pub warnings: Vec<String>,
     /// Whether some iteration needed the stabilisation (a body held only by contact).
     pub stabilised: bool,
+    /// Per body, the total contact force it receives from each obstacle or body it touches,
+    /// as (name of the other, force in N), in name order.
+    pub totals: Vec<Vec<(String, Vector3<Real>)>>,
 }
 
 /// All the bodies of a scene with contact, solved together step by step.
@@ -934,6 +937,15 @@ impl ContactSolver {
                 }
             }
             contacts.sort_by(|a, b| a.node.cmp(&b.node).then(a.with.cmp(&b.with)));
+            let mut totals: Vec<(String, Vector3<Real>)> = Vec::new();
+            for c in &contacts {
+                match totals.iter_mut().find(|(with, _)| *with == c.with) {
+                    Some((_, f)) => *f += c.force,
+                    None => totals.push((c.with.clone(), c.force)),
+                }
+            }
+            totals.sort_by(|a, b| a.0.cmp(&b.0));
+            out.totals.push(totals);
             out.states.push(state);
             out.contacts.push(contacts);
         }

@@ -5,7 +5,7 @@ use crate::contact::{ContactError, ContactSolver, NodeContact};
 use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError};
 use crate::scene::extra_outputs::{write_extra_outputs, DrawResults};
 use crate::scene::results::{
-    BodyResult, BodySize, ContactForce, PhaseSeconds, StepResult, StepSummary, Summary,
+    BodyResult, BodySize, ContactForce, PairForce, PhaseSeconds, StepResult, StepSummary, Summary,
 };
 use crate::scene::World;
 use crate::Real;
@@ -115,6 +115,7 @@ impl<'w> Simulation<'w> {
             max_penetration: 0.0,
             seconds: 0.0,
             warnings: Vec::new(),
+            contact_forces: Vec::new(),
         };
         if let Some(contact) = &self.contact {
             let solved = contact
@@ -129,6 +130,16 @@ impl<'w> Simulation<'w> {
             summary.contact_iterations = solved.contact_iterations;
             summary.max_penetration = solved.max_penetration;
             summary.warnings = solved.warnings;
+            for (body, totals) in world.bodies.iter().zip(&solved.totals) {
+                let d = body.dimension.dofs_per_node();
+                for (with, force) in totals {
+                    summary.contact_forces.push(PairForce {
+                        body: body.name.clone(),
+                        with: with.clone(),
+                        force: force.as_slice()[..d].to_vec(),
+                    });
+                }
+            }
             for ((body, state), contacts) in world
                 .bodies
                 .iter()
