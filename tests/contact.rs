@@ -398,3 +398,40 @@ fn shell_on_block_balances_and_rests_on_the_face() {
         assert!(touched, "{scene}: the shell reaches the block");
     }
 }
+
+/// The bundled stack of three 3D boxes: the two upper boxes are held vertically by contact alone
+/// and settle; at every step each interface carries the whole load (the summary's pair totals,
+/// vertical part, to 1e-6), equal and opposite across it, and reactions, loads and contact
+/// forces balance (to 1e-8 of the largest).
+#[test]
+fn stack_of_three_boxes_passes_the_load_down() {
+    let world = load_scene(Path::new("scenes/stack.toml")).unwrap();
+    for (result, summary) in run_all(&world).into_iter().skip(1) {
+        let load = 500.0 * result.load_factor;
+        let (sum, largest) = balance(&result);
+        for s in sum {
+            assert!(s.abs() <= 1e-8 * largest, "{sum:?}");
+        }
+        let total = |body: &str, with: &str| -> Vec<f64> {
+            summary
+                .contact_forces
+                .iter()
+                .find(|p| p.body == body && p.with == with)
+                .unwrap_or_else(|| panic!("{body} on {with}: {:?}", summary.contact_forces))
+                .force
+                .clone()
+        };
+        for (upper, lower) in [("middle", "bottom"), ("top", "middle")] {
+            let up = total(upper, lower);
+            let down = total(lower, upper);
+            assert!(
+                (up[1] - load).abs() <= 1e-6 * load,
+                "{upper} on {lower}: {up:?}"
+            );
+            for k in 0..3 {
+                assert!((up[k] + down[k]).abs() <= 1e-9 * load, "equal and opposite");
+            }
+        }
+        assert!(summary.residual <= 1e-9, "{summary:?}");
+    }
+}

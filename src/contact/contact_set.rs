@@ -26,6 +26,13 @@ pub enum Target {
         /// The segment: from the i-th node of the body's boundary loop to the next.
         segment: usize,
     },
+    /// A surface patch of a 3D body.
+    Patch {
+        /// The body (index in the scene).
+        body: usize,
+        /// The patch (index in the body's patches).
+        patch: usize,
+    },
     /// A boundary vertex of a 2D body, pressed along the mean normal of its two segments (a
     /// node equally near both).
     Vertex {

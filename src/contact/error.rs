@@ -1,5 +1,6 @@
 //! Why a scene with contact could not be solved.
 
+use crate::contact::SurfaceProblem;
 use crate::linkage::SolveError;
 use crate::Real;
 
@@ -39,6 +40,17 @@ pub enum ContactError {
     ArcLength {
         /// Body name.
         body: String,
+    },
+    /// A 3D body's patches cannot be a contact surface.
+    #[error("body '{body}': its patches cannot be a contact surface: {}", match problem {
+        SurfaceProblem::NotClosed([a, b]) => format!("the edge from node {a} to node {b} belongs to one patch only (the surface is open); contact needs a closed surface: add the missing patches, or remove `patches`"),
+        SurfaceProblem::Inconsistent([a, b]) => format!("two patches run along the edge from node {a} to node {b} the same way, so they face opposite sides: list every patch counter-clockwise seen from outside"),
+    })]
+    Surface {
+        /// Body name.
+        body: String,
+        /// What is wrong.
+        problem: SurfaceProblem,
     },
     /// The result is not finite.
     #[error("step {step}: the solution with contact is not finite: check the penalty ([contact] penalty) and the loads")]

@@ -11,9 +11,10 @@
 
 use crate::contact::boundary::boundary_loop;
 use crate::contact::coupled_system::CoupledSystem;
+use crate::contact::patch_surface::{triangle_projection, PatchSurface};
 use crate::contact::{
     default_penalty, penetration_tolerance, ActiveContact, ContactError, ContactSet,
-    ContactSettings, NodeContact, Obstacle, Obstacles, Penalty, Target,
+    ContactSettings, NodeContact, Obstacle, Obstacles, Penalty, SurfaceProblem, Target,
 };
 use crate::linkage::cholesky::CholeskyError;
 use crate::linkage::{
@@ -96,6 +97,8 @@ pub struct ContactSolver {
     node_offsets: Vec<usize>,
     /// Contact surface of each body (2D: its outer boundary), `None` if it has none.
     surfaces: Vec<Option<Surface>>,
+    /// Contact surface of each 3D body: its patches, facing out.
+    patch_surfaces: Vec<Option<PatchSurface>>,
     /// Entries between bodies added to the coupled pattern so far (global free DOFs, r ≥ c).
     coupling: Vec<(usize, usize)>,
     obstacles: Obstacles,
@@ -164,10 +167,25 @@ impl ContactSolver {
             ..Default::default()
         };
         let surfaces = bodies.iter().map(Surface::of).collect();
+        let mut patch_surfaces = Vec::with_capacity(bodies.len());
+        for body in bodies {
+            // An open shell is not a contact target yet (its nodes still press on the others).
+            patch_surfaces.push(match PatchSurface::of(body) {
+                Ok(surface) => surface,
+                Err(SurfaceProblem::NotClosed(_)) => None,
+                Err(problem) => {
+                    return Err(ContactError::Surface {
+                        body: body.name.clone(),
+                        problem,
+                    })
+                }
+            });
+        }
         Ok(ContactSolver {
             parts,
             node_offsets,
             surfaces,
+            patch_surfaces,
             coupling: Vec::new(),
             obstacles: Obstacles::new(obstacles),
             system,
@@ -317,6 +335,35 @@ impl ContactSolver {
                         p.normal,
                         vec![(c.body, c.node, 1.0)],
                         self.parts[c.body].penalty,
+                    )
+                }
+                Target::Patch { body, patch } => {
+                    let Some(surface) = self.patch_surfaces[body].as_ref() else {
+                        continue;
+                    };
+                    let [a, b, cc] = surface.patches[patch];
+                    let t = triangle_projection(
+                        &x,
+                        &self.position(bodies, body, a),
+                        &self.position(bodies, body, b),
+                        &self.position(bodies, body, cc),
+                    );
+                    let penalty = Penalty {
+                        stiffness: self.parts[c.body]
+                            .penalty
+                            .stiffness
+                            .min(self.parts[body].penalty.stiffness),
+                    };
+                    (
+                        t.depth,
+                        t.normal,
+                        vec![
+                            (c.body, c.node, 1.0),
+                            (body, a, -t.weights[0]),
+                            (body, b, -t.weights[1]),
+                            (body, cc, -t.weights[2]),
+                        ],
+                        penalty,
                     )
                 }
                 Target::Vertex { body, vertex } => {
@@ -751,6 +798,15 @@ impl ContactSolver {
                 .iter()
                 .map(|p| p.tolerance)
                 .fold(Real::INFINITY, Real::min);
+        let meshes: Vec<_> = self
+            .patch_surfaces
+            .iter()
+            .enumerate()
+            .map(|(b, s)| {
+                s.as_ref()
+                    .and_then(|s| s.mesh(|n| self.position(bodies, b, n)))
+            })
+            .collect();
         let mut found = Vec::new();
         for (b, body) in bodies.iter().enumerate() {
             for node in 0..body.nodes.len() {
@@ -812,6 +868,17 @@ impl ContactSolver {
                     };
                     consider(target, distances[i]);
                 }
+                for (other, mesh) in meshes.iter().enumerate() {
+                    let Some((mesh, [lo, hi])) = mesh else {
+                        continue;
+                    };
+                    if other == b || (0..3).any(|k| x[k] < lo[k] || x[k] > hi[k]) {
+                        continue;
+                    }
+                    if let Some((patch, depth)) = PatchSurface::inside(mesh, &x) {
+                        consider(Target::Patch { body: other, patch }, depth);
+                    }
+                }
                 if let Some((with, _)) = deepest {
                     found.push(ActiveContact {
                         body: b,
@@ -828,7 +895,9 @@ impl ContactSolver {
     fn target_name<'a>(&'a self, bodies: &'a [Body], with: Target) -> &'a str {
         match with {
             Target::Obstacle(o) => self.obstacles.name(o),
-            Target::Segment { body, .. } | Target::Vertex { body, .. } => &bodies[body].name,
+            Target::Segment { body, .. }
+            | Target::Vertex { body, .. }
+            | Target::Patch { body, .. } => &bodies[body].name,
         }
     }
 
