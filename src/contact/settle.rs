@@ -114,6 +114,8 @@ pub struct ContactSolver {
     move_cap: Real,
     /// The body whose tangent was singular last (for messages).
     unheld: usize,
+    /// The contact set the current factorization was made with (not stabilised).
+    factored: Option<ContactSet>,
     /// Time spent so far in each phase, s.
     pub times: PhaseTimes,
     /// Time spent so far finding contacts (projecting nodes on obstacles), s.
@@ -199,6 +201,7 @@ impl ContactSolver {
                 .map(|b| 10.0 * penetration_tolerance(b))
                 .fold(Real::INFINITY, Real::min),
             unheld: 0,
+            factored: None,
             times,
             query_seconds: 0.0,
         })
@@ -528,6 +531,7 @@ impl ContactSolver {
         let mut history = Vec::new();
         let mut iterations = 0;
         let mut last_step = Real::INFINITY;
+        let linear = bodies.iter().all(|b| !b.is_nonlinear());
         loop {
             let t = Instant::now();
             let (r, scale) = self.out_of_balance(bodies, set, forces, offsets);
@@ -562,7 +566,20 @@ impl ContactSolver {
                     history,
                 });
             }
-            let stabilised = self.factorize_tangent(bodies, set, offsets)?;
+            // Linear bodies with the same contacts keep their tangent but for the small turn of
+            // the contact normals: reuse the factor (a modified Newton step) while it converges.
+            let reuse = linear
+                && self.factored.as_ref() == Some(set)
+                && iterations > 0
+                && history.len() >= 2
+                && history[history.len() - 1] < 0.1 * history[history.len() - 2];
+            let stabilised = if reuse {
+                false
+            } else {
+                let stabilised = self.factorize_tangent(bodies, set, offsets)?;
+                self.factored = (!stabilised).then(|| set.clone());
+                stabilised
+            };
             let t = Instant::now();
             let mut delta = r;
             self.system.solve_in_place(&mut delta);
