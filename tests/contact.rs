@@ -435,3 +435,28 @@ fn stack_of_three_boxes_passes_the_load_down() {
         assert!(summary.residual <= 1e-9, "{summary:?}");
     }
 }
+
+/// Contact with large displacements: disk_on_floor with `kinematics = "large"` still balances
+/// at every step (to 1e-8 of the largest force) and the floor pushes straight up.
+#[test]
+fn large_displacement_disk_on_floor_balances() {
+    let text = std::fs::read_to_string("scenes/disk_on_floor.toml")
+        .unwrap()
+        .replace(
+            "disk = { radius = 0.1, rings = 6, sectors = 32 }",
+            "disk = { radius = 0.1, rings = 6, sectors = 32 }\nkinematics = \"large\"",
+        );
+    assert!(text.contains("kinematics = \"large\""));
+    let world = build_world(&text, Path::new("scenes/disk_on_floor.toml")).unwrap();
+    for (result, summary) in run_all(&world).into_iter().skip(1) {
+        let (sum, largest) = balance(&result);
+        for s in sum {
+            assert!(s.abs() <= 1e-8 * largest, "{sum:?}");
+        }
+        assert!(!result.bodies[0].contacts.is_empty());
+        for c in &result.bodies[0].contacts {
+            assert!(c.force[0].abs() <= 1e-9 * c.force[1]);
+        }
+        assert!(summary.residual <= 1e-9);
+    }
+}
