@@ -460,3 +460,64 @@ fn large_displacement_disk_on_floor_balances() {
         assert!(summary.residual <= 1e-9);
     }
 }
+
+/// A unit cube given as an OBJ triangle mesh (counter-clockwise seen from outside) acts exactly
+/// like the same cube as a cuboid obstacle: a 3D box pressed onto it gets the same contacts and
+/// displacements (to 1e-9 of the largest).
+#[test]
+fn mesh_obstacle_matches_the_cuboid() {
+    let cube_obj = "\
+v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n\
+v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+    let scene = |obstacle: &str| {
+        format!(
+            r#"
+name = "box_on_cube"
+steps = 2
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "box"
+box_lattice = {{ size = [0.2, 0.1, 0.2], cells = [2, 2, 2] }}
+offset = [-0.1, 0.5, -0.1]
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.6, 0.0], normal = [0.0, 1.0, 0.0] }}
+fix = ["x", "y", "z"]
+displacement = [0.0, -0.002, 0.0]
+[[obstacles]]
+name = "cube"
+{obstacle}
+"#
+        )
+    };
+    let (_dir, mesh_path) = scene_with(
+        &[("cube.obj", cube_obj)],
+        &scene("shape = \"mesh\"\nfile = \"cube.obj\""),
+    );
+    let with_mesh = run_all(&load_scene(&mesh_path).unwrap());
+    let cuboid = build_world(
+        &scene("shape = \"cuboid\"\ncenter = [0.0, 0.0, 0.0]\nhalf_extents = [0.5, 0.5, 0.5]"),
+        Path::new("box_on_cube.toml"),
+    )
+    .unwrap();
+    let with_cuboid = run_all(&cuboid);
+    let (a, b) = (&with_mesh[2].0.bodies[0], &with_cuboid[2].0.bodies[0]);
+    assert_eq!(a.contacts.len(), 9, "the bottom face's 3 × 3 nodes");
+    assert_eq!(a.contacts.len(), b.contacts.len());
+    let largest = b
+        .displacements
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    for (u, v) in a
+        .displacements
+        .iter()
+        .flatten()
+        .zip(b.displacements.iter().flatten())
+    {
+        assert!((u - v).abs() <= 1e-9 * largest);
+    }
+}

@@ -52,6 +52,9 @@ pub enum ContactError {
         /// What is wrong.
         problem: SurfaceProblem,
     },
+    /// An obstacle could not be built.
+    #[error("an obstacle could not be built: {0}")]
+    Obstacle(String),
     /// The result is not finite.
     #[error("step {step}: the solution with contact is not finite: check the penalty ([contact] penalty) and the loads")]
     NotFinite {

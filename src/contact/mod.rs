@@ -4,7 +4,7 @@ pub use self::boundary::boundary_loop;
 pub use self::contact_set::{ActiveContact, ContactSet, NodeContact, Target};
 pub use self::error::ContactError;
 pub use self::obstacle::{Obstacle, ObstacleShape};
-pub use self::obstacles::{ObstacleProjection, Obstacles};
+pub use self::obstacles::{mesh_collider, ObstacleProjection, Obstacles};
 pub use self::patch_surface::{PatchSurface, SurfaceProblem};
 pub use self::penalty::{default_penalty, penetration_tolerance, Penalty, PENALTY_FACTOR};
 pub use self::settings::ContactSettings;

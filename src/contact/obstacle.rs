@@ -43,6 +43,13 @@ pub enum ObstacleShape {
         /// Rotation vector, rad.
         rotation: Vector3<Real>,
     },
+    /// A closed triangle mesh, counter-clockwise seen from outside (3D).
+    Mesh {
+        /// Vertices, m.
+        vertices: Vec<Vector3<Real>>,
+        /// Triangles, 0-based vertex indices.
+        triangles: Vec<[usize; 3]>,
+    },
     /// A capsule (a segment swept by a ball) whose axis is the local y axis.
     Capsule {
         /// Centre, m.

@@ -5,6 +5,7 @@ use crate::Real;
 use nalgebra::Vector3;
 use rapier3d_f64::geometry::{ColliderBuilder, ColliderHandle, ColliderSet, SharedShape};
 use rapier3d_f64::math::{Pose, Vector};
+use rapier3d_f64::parry::shape::TriMeshFlags;
 
 /// Where a node stands against one obstacle.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,9 +36,25 @@ fn from_glam(v: Vector) -> Vector3<Real> {
     Vector3::new(v.x, v.y, v.z)
 }
 
+/// A fixed collider for a closed triangle mesh, oriented (so that points inside are told from
+/// points outside).
+pub fn mesh_collider(
+    vertices: &[Vector3<Real>],
+    triangles: &[[usize; 3]],
+) -> Result<ColliderBuilder, String> {
+    let indices = triangles.iter().map(|t| t.map(|i| i as u32)).collect();
+    ColliderBuilder::trimesh_with_flags(
+        vertices.iter().map(to_glam).collect(),
+        indices,
+        TriMeshFlags::ORIENTED | TriMeshFlags::MERGE_DUPLICATE_VERTICES,
+    )
+    .map_err(|e| format!("the triangle mesh cannot be built: {e}"))
+}
+
 impl Obstacles {
-    /// Insert every obstacle of `list` as a fixed collider.
-    pub fn new(list: &[Obstacle]) -> Self {
+    /// Insert every obstacle of `list` as a fixed collider. Fails (naming the obstacle) for a
+    /// triangle mesh parry cannot build.
+    pub fn new(list: &[Obstacle]) -> Result<Self, String> {
         let mut colliders = ColliderSet::new();
         let mut entries = Vec::with_capacity(list.len());
         for obstacle in list {
@@ -69,11 +86,15 @@ impl Obstacles {
                     rotation,
                 } => ColliderBuilder::capsule_y(*half_height, *radius)
                     .position(Pose::new(to_glam(center), to_glam(rotation))),
+                ObstacleShape::Mesh {
+                    vertices,
+                    triangles,
+                } => mesh_collider(vertices, triangles)?,
             };
             let handle = colliders.insert(collider.build());
             entries.push((handle, obstacle.clone()));
         }
-        Obstacles { colliders, entries }
+        Ok(Obstacles { colliders, entries })
     }
 
     /// Number of obstacles.
@@ -143,6 +164,7 @@ mod tests {
             travel: Vector3::zeros(),
             schedule: Schedule::Linear,
         }])
+        .unwrap()
     }
 
     #[test]

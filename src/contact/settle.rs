@@ -189,7 +189,7 @@ impl ContactSolver {
             surfaces,
             patch_surfaces,
             coupling: Vec::new(),
-            obstacles: Obstacles::new(obstacles),
+            obstacles: Obstacles::new(obstacles).map_err(ContactError::Obstacle)?,
             system,
             settings,
             active: ContactSet::default(),

@@ -145,7 +145,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
                 "obstacles need all bodies of one dimension (all 2D or all 3D)".to_string(),
             ));
         }
-        let obstacle = obstacle_from(o.get_ref(), dimension, spec.steps, &bodies)
+        let obstacle = obstacle_from(o.get_ref(), dimension, spec.steps, &bodies, folder)
             .map_err(|e| at(o.span(), e))?;
         if obstacles.iter().any(|p| p.name == obstacle.name) {
             return Err(at(

@@ -16,6 +16,7 @@ pub use self::world::{OutputSettings, World};
 
 mod build;
 mod extra_outputs;
+mod mesh_file;
 mod model_file;
 mod obstacles;
 mod pictures;

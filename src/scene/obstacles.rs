@@ -1,12 +1,14 @@
 //! Building the scene's rigid obstacles and contact settings from `[[obstacles]]` and
 //! `[contact]`.
 
-use crate::contact::{ContactSettings, Obstacle, ObstacleShape};
+use crate::contact::{mesh_collider, ContactSettings, Obstacle, ObstacleShape};
 use crate::linkage::{Body, Dimension, Schedule};
+use crate::scene::mesh_file::read_mesh;
 use crate::scene::selector::vector;
 use crate::scene::spec::{ContactSpec, ObstacleSpec};
 use crate::Real;
 use nalgebra::Vector3;
+use std::path::Path;
 
 /// The obstacle described by `spec` in a scene of `dimension` with `steps` steps. Errors say
 /// what is wrong and what to do (the caller adds the file and line).
@@ -15,6 +17,7 @@ pub(crate) fn obstacle_from(
     dimension: Dimension,
     steps: usize,
     bodies: &[Body],
+    folder: &Path,
 ) -> Result<Obstacle, String> {
     let name = &spec.name;
     let fail = |m: String| format!("obstacle '{name}': {m}");
@@ -102,13 +105,27 @@ pub(crate) fn obstacle_from(
             rotation: rotation()?,
         },
         "mesh" => {
-            return Err(fail(
-                "shape = \"mesh\" (a triangle mesh from OBJ or STL) is not supported yet: use half_space, cuboid, ball, cylinder or capsule".to_string(),
-            ))
+            if dimension != Dimension::Three {
+                return Err(fail(
+                    "a mesh obstacle needs 3D bodies: in 2D use half_space, cuboid, ball, cylinder or capsule".to_string(),
+                ));
+            }
+            let Some(file) = &spec.file else {
+                return Err(fail(
+                    "a mesh needs `file`: an OBJ or ASCII STL file (m), relative to the scene file"
+                        .to_string(),
+                ));
+            };
+            let (vertices, triangles) = read_mesh(&folder.join(file))?;
+            let _checked = mesh_collider(&vertices, &triangles).map_err(&fail)?;
+            ObstacleShape::Mesh {
+                vertices,
+                triangles,
+            }
         }
         other => {
             return Err(fail(format!(
-                "shape = {other:?}: use \"half_space\", \"cuboid\", \"ball\", \"cylinder\" or \"capsule\""
+                "shape = {other:?}: use \"half_space\", \"cuboid\", \"ball\", \"cylinder\", \"capsule\" or \"mesh\""
             )))
         }
     };

@@ -47,7 +47,7 @@ pub struct ContactSpec {
 pub struct ObstacleSpec {
     /// Name, distinct from every body's and obstacle's name.
     pub name: String,
-    /// `"half_space"`, `"cuboid"`, `"ball"`, `"cylinder"` or `"capsule"`.
+    /// `"half_space"`, `"cuboid"`, `"ball"`, `"cylinder"`, `"capsule"` or `"mesh"`.
     pub shape: String,
     /// A point on the boundary of a half-space, m.
     pub point: Option<Vec<Real>>,
@@ -63,6 +63,8 @@ pub struct ObstacleSpec {
     pub half_height: Option<Real>,
     /// Rotation, degrees: about z in 2D (one number), a rotation vector (axis times angle) in 3D.
     pub rotation: Option<Vec<Real>>,
+    /// Triangle mesh file of a `"mesh"` obstacle (OBJ or ASCII STL, m), relative to the scene.
+    pub file: Option<String>,
     /// Translation reached at the last step, m.
     pub travel: Option<Vec<Real>>,
     /// Factor of the travel per step 1..=steps (default: linear ramp).
