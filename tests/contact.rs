@@ -521,3 +521,62 @@ name = "cube"
         assert!((u - v).abs() <= 1e-9 * largest);
     }
 }
+
+/// Bad contact input is reported before anything is solved: a missing mesh file names the file,
+/// and a 3D body whose patches face both ways names the edge where they disagree.
+#[test]
+fn bad_mesh_file_and_inconsistent_patches_are_reported() {
+    let base = r#"
+name = "s"
+[[materials]]
+name = "m"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "box"
+nodes = "box.nodes"
+links = "box.links"
+patches = "box.patches"
+[[bodies.supports]]
+nodes = [1, 2, 3]
+fix = ["x", "y", "z"]
+"#;
+    // A tetrahedron; its last patch is listed clockwise.
+    let nodes = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+    let links = "1 2\n1 3\n1 4\n2 3\n2 4\n3 4\n";
+    let patches = "1 3 2\n1 2 4\n2 3 4\n1 4 3\n";
+    let broken = "1 3 2\n1 2 4\n2 3 4\n1 3 4\n";
+    let files = |p: &'static str| {
+        [
+            ("box.nodes", nodes),
+            ("box.links", links),
+            ("box.patches", p),
+        ]
+    };
+    let missing =
+        format!("{base}[[obstacles]]\nname = \"o\"\nshape = \"mesh\"\nfile = \"nowhere.obj\"\n");
+    let (_dir, path) = scene_with(&files(patches), &missing);
+    let err = load_scene(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("nowhere.obj") && err.contains("cannot read"),
+        "{err}"
+    );
+
+    let with_contact = format!("{base}[contact]\n");
+    let (_dir, path) = scene_with(&files(patches), &with_contact);
+    let world = load_scene(&path).unwrap();
+    assert!(
+        Simulation::new(&world).is_ok(),
+        "a consistent closed surface"
+    );
+    let (_dir, path) = scene_with(&files(broken), &with_contact);
+    let world = load_scene(&path).unwrap();
+    let err = match Simulation::new(&world) {
+        Ok(_) => panic!("inconsistent patches must be reported"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("body 'box'") && err.contains("counter-clockwise"),
+        "{err}"
+    );
+}
