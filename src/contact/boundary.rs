@@ -1,7 +1,9 @@
-//! The contact surface of a 2D body: its outer boundary, found from the members.
+//! The contact surface of a 2D body: its outer boundary, found from the members, and points
+//! against its segments.
 
-use crate::linkage::Body;
+use crate::linkage::{Body, Dimension};
 use crate::Real;
+use nalgebra::Vector3;
 use std::f64::consts::TAU;
 
 /// The outer boundary of a planar linkage as a closed loop of nodes, counter-clockwise (the body
@@ -62,6 +64,89 @@ pub fn boundary_loop(body: &Body) -> Option<Vec<usize>> {
         loop_nodes.push(next);
     }
     None
+}
+
+/// A contact surface: the closed loop of boundary nodes of a 2D body, counter-clockwise.
+pub(crate) struct Surface {
+    /// Body nodes of the loop, in order.
+    pub(crate) nodes: Vec<usize>,
+}
+
+impl Surface {
+    /// The boundary of a 2D body; `None` for a 3D body or a boundary that cannot be traced.
+    pub(crate) fn of(body: &Body) -> Option<Surface> {
+        if body.dimension != Dimension::Two {
+            return None;
+        }
+        boundary_loop(body).map(|nodes| Surface { nodes })
+    }
+
+    /// The segment before segment `i` in the loop.
+    pub(crate) fn previous(&self, i: usize) -> usize {
+        (i + self.nodes.len() - 1) % self.nodes.len()
+    }
+
+    /// The segment after segment `i` in the loop.
+    pub(crate) fn next(&self, i: usize) -> usize {
+        (i + 1) % self.nodes.len()
+    }
+
+    /// The end nodes of segment `i`.
+    pub(crate) fn segment(&self, i: usize) -> (usize, usize) {
+        (self.nodes[i], self.nodes[(i + 1) % self.nodes.len()])
+    }
+}
+
+/// A point against a boundary segment from `a` to `b` of a counter-clockwise loop.
+pub(crate) struct SegmentProjection {
+    /// Barycentric weight of `b` of the nearest point (0 at a, 1 at b).
+    pub(crate) t: Real,
+    /// Distance to the nearest point, m.
+    pub(crate) distance: Real,
+    /// Depth behind the segment's line along its outward normal, m (negative in front).
+    pub(crate) depth: Real,
+    /// Outward unit normal (to the right of a → b).
+    pub(crate) normal: Option<Vector3<Real>>,
+}
+
+/// Project `x` on the segment `a`–`b` (z = 0).
+pub(crate) fn segment_projection(
+    x: &Vector3<Real>,
+    a: &Vector3<Real>,
+    b: &Vector3<Real>,
+) -> SegmentProjection {
+    let e = b - a;
+    let length2 = e.norm_squared();
+    let t = if length2 > 0.0 {
+        ((x - a).dot(&e) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let nearest = a + e * t;
+    let normal = if length2 > 0.0 {
+        Some(Vector3::new(e.y, -e.x, 0.0) / length2.sqrt())
+    } else {
+        None
+    };
+    SegmentProjection {
+        t,
+        distance: (x - nearest).norm(),
+        depth: normal.map_or(0.0, |n| (nearest - x).dot(&n)),
+        normal,
+    }
+}
+
+/// Whether `x` lies inside the closed polygon `points` (even–odd rule, z ignored).
+pub(crate) fn inside_polygon(x: &Vector3<Real>, points: &[Vector3<Real>]) -> bool {
+    let mut inside = false;
+    let n = points.len();
+    for i in 0..n {
+        let (p, q) = (points[i], points[(i + n - 1) % n]);
+        if (p.y > x.y) != (q.y > x.y) && x.x < (q.x - p.x) * (x.y - p.y) / (q.y - p.y) + p.x {
+            inside = !inside;
+        }
+    }
+    inside
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 //! the set solved. A set seen before (the contact flips back and forth) ends the loop with a
 //! warning, as does running out of contact iterations.
 
-use crate::contact::boundary::boundary_loop;
+use crate::contact::boundary::{inside_polygon, segment_projection, Surface};
 use crate::contact::coupled_system::CoupledSystem;
 use crate::contact::patch_surface::{triangle_projection, PatchSurface};
 use crate::contact::{
@@ -18,8 +18,8 @@ use crate::contact::{
 };
 use crate::linkage::cholesky::CholeskyError;
 use crate::linkage::{
-    member_response, post_process, Body, Dimension, DofMap, PathMethod, PhaseTimes, Schedule,
-    SolveError, StepState, StiffnessAssembly,
+    member_response, post_process, Body, DofMap, PathMethod, PhaseTimes, Schedule, SolveError,
+    StepState, StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
@@ -1037,88 +1037,6 @@ impl ContactSolver {
         }
         Ok(out)
     }
-}
-
-/// A contact surface: the closed loop of boundary nodes of a 2D body, counter-clockwise.
-struct Surface {
-    nodes: Vec<usize>,
-}
-
-impl Surface {
-    /// The boundary of a 2D body; `None` for a 3D body or a boundary that cannot be traced.
-    fn of(body: &Body) -> Option<Surface> {
-        if body.dimension != Dimension::Two {
-            return None;
-        }
-        boundary_loop(body).map(|nodes| Surface { nodes })
-    }
-
-    /// The segment before segment `i` in the loop.
-    fn previous(&self, i: usize) -> usize {
-        (i + self.nodes.len() - 1) % self.nodes.len()
-    }
-
-    /// The segment after segment `i` in the loop.
-    fn next(&self, i: usize) -> usize {
-        (i + 1) % self.nodes.len()
-    }
-
-    /// The end nodes of segment `i`.
-    fn segment(&self, i: usize) -> (usize, usize) {
-        (self.nodes[i], self.nodes[(i + 1) % self.nodes.len()])
-    }
-}
-
-/// A point against a boundary segment from `a` to `b` of a counter-clockwise loop.
-struct SegmentProjection {
-    /// Barycentric weight of `b` of the nearest point (0 at a, 1 at b).
-    t: Real,
-    /// Distance to the nearest point, m.
-    distance: Real,
-    /// Depth behind the segment's line along its outward normal, m (negative in front).
-    depth: Real,
-    /// Outward unit normal (to the right of a → b).
-    normal: Option<Vector3<Real>>,
-}
-
-/// Project `x` on the segment `a`–`b` (z = 0).
-fn segment_projection(
-    x: &Vector3<Real>,
-    a: &Vector3<Real>,
-    b: &Vector3<Real>,
-) -> SegmentProjection {
-    let e = b - a;
-    let length2 = e.norm_squared();
-    let t = if length2 > 0.0 {
-        ((x - a).dot(&e) / length2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let nearest = a + e * t;
-    let normal = if length2 > 0.0 {
-        Some(Vector3::new(e.y, -e.x, 0.0) / length2.sqrt())
-    } else {
-        None
-    };
-    SegmentProjection {
-        t,
-        distance: (x - nearest).norm(),
-        depth: normal.map_or(0.0, |n| (nearest - x).dot(&n)),
-        normal,
-    }
-}
-
-/// Whether `x` lies inside the closed polygon `points` (even–odd rule, z ignored).
-fn inside_polygon(x: &Vector3<Real>, points: &[Vector3<Real>]) -> bool {
-    let mut inside = false;
-    let n = points.len();
-    for i in 0..n {
-        let (p, q) = (points[i], points[(i + n - 1) % n]);
-        if (p.y > x.y) != (q.y > x.y) && x.x < (q.x - p.x) * (x.y - p.y) / (q.y - p.y) + p.x {
-            inside = !inside;
-        }
-    }
-    inside
 }
 
 fn node_vector(u: &[Real], d: usize, node: usize) -> Vector3<Real> {
