@@ -39,6 +39,7 @@ pub type Real = f64;
 pub mod atomic_file;
 pub mod bench;
 pub mod bench_large;
+pub mod contact;
 pub mod linkage;
 pub mod render;
 pub mod scene;

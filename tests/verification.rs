@@ -310,8 +310,8 @@ fn symmetric_disk_gives_mirror_symmetric_answer() {
     assert_eq!(pairs, body.nodes.len());
 }
 
-/// Equilibrium on every bundled scene: at every step the loads and reactions of all bodies sum
-/// to zero to 1e-9 of the applied load.
+/// Equilibrium on every bundled scene: at every step the loads, reactions and contact forces of
+/// all bodies sum to zero to 1e-9 of the largest of them.
 #[test]
 fn every_bundled_scene_is_in_equilibrium() {
     let mut scenes: Vec<_> = std::fs::read_dir("scenes")
@@ -339,6 +339,13 @@ fn every_bundled_scene_is_in_equilibrium() {
                 }
                 for f in &b.reactions {
                     scale = scale.max(f.force.iter().map(|c| c * c).sum::<f64>().sqrt());
+                }
+                // Contact forces (issue 5): obstacles push the bodies, bodies push each other.
+                for c in &b.contacts {
+                    for (k, x) in c.force.iter().enumerate() {
+                        total[k] += x;
+                    }
+                    scale = scale.max(c.force.iter().map(|x| x * x).sum::<f64>().sqrt());
                 }
             }
             let norm = total.iter().map(|c| c * c).sum::<f64>().sqrt();

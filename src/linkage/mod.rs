@@ -23,6 +23,7 @@ pub use self::smoothed_aggregation::{MultigridError, SmoothedAggregation};
 pub use self::solver_choice::{
     IterativeSettings, SolverChoice, SolverSettings, AUTO_ITERATIVE_DOFS_2D, AUTO_ITERATIVE_DOFS_3D,
 };
+pub(crate) use self::step_state::post_process;
 pub use self::step_state::StepState;
 pub use self::symmetric_csr::{dot, Preconditioner, SymmetricCsr};
 

@@ -1,11 +1,13 @@
 //! From a scene file to a checked [`World`]: every problem is reported with the file and line.
 
+use crate::contact::Obstacle;
 use crate::linkage::generators;
 use crate::linkage::paper_files::{self, PaperFileError};
 use crate::linkage::{
     Behaviour, Body, Dimension, Geometry, Kinematics, Material, Member, NewtonSettings, NodalLoad,
     PathMethod, Schedule, SolverChoice, SolverSettings, Support,
 };
+use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
 use crate::scene::{OutputSettings, PictureSettings, World};
@@ -132,7 +134,34 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         body.validate().map_err(|e| at(b.span(), e.to_string()))?;
         bodies.push(body);
     }
+    let contact = contact_settings(spec.contact.as_ref().map(|c| c.get_ref()))
+        .map_err(|e| at(spec.contact.as_ref().map_or(0..0, |c| c.span()), e))?;
+    let mut obstacles: Vec<Obstacle> = Vec::new();
+    for o in &spec.obstacles {
+        let dimension = bodies[0].dimension;
+        if bodies.iter().any(|b| b.dimension != dimension) {
+            return Err(at(
+                o.span(),
+                "obstacles need all bodies of one dimension (all 2D or all 3D)".to_string(),
+            ));
+        }
+        let obstacle = obstacle_from(o.get_ref(), dimension, spec.steps, &bodies, folder)
+            .map_err(|e| at(o.span(), e))?;
+        if obstacles.iter().any(|p| p.name == obstacle.name) {
+            return Err(at(
+                o.span(),
+                format!(
+                    "obstacle '{}' is defined twice: names must differ",
+                    obstacle.name
+                ),
+            ));
+        }
+        obstacles.push(obstacle);
+    }
     Ok(World {
+        obstacles,
+        contact,
+        contact_table: spec.contact.is_some(),
         name: spec.name,
         steps: spec.steps,
         bodies,
@@ -360,6 +389,10 @@ fn build_body(
         return Err(here(
             "patches are for 3D bodies; this body's nodes have 2 coordinates".to_string(),
         ));
+    }
+    if let Some(offset) = &spec.offset {
+        let shift = vector(offset, body.dimension, "offset").map_err(&here)?;
+        body.nodes.iter_mut().for_each(|p| *p += shift);
     }
 
     let schedule = |s: &Option<Vec<f64>>| -> Result<Schedule, String> {

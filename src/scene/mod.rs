@@ -5,7 +5,8 @@ pub use self::extra_outputs::DrawResults;
 pub use self::model_file::{ModelBody, ModelFile, SupportedNode};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::results::{
-    BodyResult, BodySize, ContactForce, NodeForce, PhaseSeconds, StepResult, StepSummary, Summary,
+    BodyResult, BodySize, ContactForce, NodeForce, PairForce, PhaseSeconds, StepResult,
+    StepSummary, Summary,
 };
 pub use self::selector::select_nodes;
 pub use self::simulation::{run, run_with, RunError, Simulation};
@@ -15,7 +16,9 @@ pub use self::world::{OutputSettings, World};
 
 mod build;
 mod extra_outputs;
+mod mesh_file;
 mod model_file;
+mod obstacles;
 mod pictures;
 mod results;
 mod selector;

@@ -52,6 +52,17 @@ pub struct BodyResult {
     pub contacts: Vec<ContactForce>,
 }
 
+/// The total contact force one body receives from one obstacle or other body at a step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairForce {
+    /// The body.
+    pub body: String,
+    /// The obstacle or body it touches.
+    pub with: String,
+    /// Sum of the contact forces on the body's nodes from it, N (one component per dimension).
+    pub force: Vec<Real>,
+}
+
 /// One stored step: `steps/NNNN.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StepResult {
@@ -99,6 +110,14 @@ pub struct StepSummary {
     pub max_penetration: Real,
     /// Wall time of the step, s (step 1 includes assembly and factorization).
     pub seconds: Real,
+    /// Total contact force per pair: what each body receives from each obstacle or body it
+    /// touches (absent without contact).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contact_forces: Vec<PairForce>,
+    /// What the user should know about the step: penetration above the tolerance, a contact
+    /// set that did not settle (absent when there is nothing to say).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// Size of one body, as reported in `summary.json`.
@@ -138,6 +157,9 @@ pub struct PhaseSeconds {
     /// Drawing pictures (PNG frames, GIF) of the stored steps.
     #[serde(default)]
     pub drawing: Real,
+    /// Finding contacts (projecting nodes on obstacles and surfaces).
+    #[serde(default)]
+    pub contact_query: Real,
 }
 
 /// `summary.json`.

@@ -1,21 +1,28 @@
 //! The load-step driver: solve every body at every step and write the results.
 
 use crate::atomic_file::write_atomically;
-use crate::linkage::{BodySolver, SolveError};
+use crate::contact::{ContactError, ContactSolver, NodeContact};
+use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError};
 use crate::scene::extra_outputs::{write_extra_outputs, DrawResults};
-use crate::scene::results::{BodyResult, BodySize, PhaseSeconds, StepResult, StepSummary, Summary};
+use crate::scene::results::{
+    BodyResult, BodySize, ContactForce, PairForce, PhaseSeconds, StepResult, StepSummary, Summary,
+};
 use crate::scene::World;
 use crate::Real;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// A world ready to step: each body's stiffness assembled and factored once.
 pub struct Simulation<'w> {
     /// The scene being run.
     pub world: &'w World,
-    /// One solver per body, in scene order: linear superposition, or Newton for a nonlinear body.
+    /// One solver per body, in scene order: linear superposition, or Newton for a nonlinear body
+    /// (empty in a scene with contact).
     pub equilibria: Vec<BodySolver>,
+    /// All bodies solved together with their contacts, in a scene with obstacles or `[contact]`.
+    pub contact: Option<Mutex<ContactSolver>>,
 }
 
 /// Why a run stopped.
@@ -28,6 +35,14 @@ pub enum RunError {
         scene: PathBuf,
         /// What went wrong.
         source: SolveError,
+    },
+    /// The bodies in contact could not be solved.
+    #[error("{scene}: {source}")]
+    Contact {
+        /// Scene file.
+        scene: PathBuf,
+        /// What went wrong.
+        source: ContactError,
     },
     /// A result file could not be written.
     #[error("{path}: cannot write: {source}")]
@@ -50,6 +65,18 @@ pub enum RunError {
 impl<'w> Simulation<'w> {
     /// Assemble and factor every body of `world`.
     pub fn new(world: &'w World) -> Result<Self, RunError> {
+        if world.has_contact() {
+            let solver = ContactSolver::new(&world.bodies, &world.obstacles, world.contact)
+                .map_err(|source| RunError::Contact {
+                    scene: world.source.clone(),
+                    source,
+                })?;
+            return Ok(Simulation {
+                world,
+                equilibria: Vec::new(),
+                contact: Some(Mutex::new(solver)),
+            });
+        }
         let equilibria = world
             .bodies
             .iter()
@@ -59,7 +86,11 @@ impl<'w> Simulation<'w> {
                 scene: world.source.clone(),
                 source,
             })?;
-        Ok(Simulation { world, equilibria })
+        Ok(Simulation {
+            world,
+            equilibria,
+            contact: None,
+        })
     }
 
     /// The result of `step` (0..=steps) and its summary line (without the time).
@@ -84,7 +115,51 @@ impl<'w> Simulation<'w> {
             overloaded: 0,
             max_penetration: 0.0,
             seconds: 0.0,
+            warnings: Vec::new(),
+            contact_forces: Vec::new(),
         };
+        if let Some(contact) = &self.contact {
+            let solved = contact
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner())
+                .solve_step(&world.bodies, &world.obstacles, step, world.steps)
+                .map_err(|source| RunError::Contact {
+                    scene: world.source.clone(),
+                    source,
+                })?;
+            summary.iterations = solved.newton_iterations;
+            summary.contact_iterations = solved.contact_iterations;
+            summary.max_penetration = solved.max_penetration;
+            summary.warnings = solved.warnings;
+            for (body, totals) in world.bodies.iter().zip(&solved.totals) {
+                let d = body.dimension.dofs_per_node();
+                for (with, force) in totals {
+                    summary.contact_forces.push(PairForce {
+                        body: body.name.clone(),
+                        with: with.clone(),
+                        force: force.as_slice()[..d].to_vec(),
+                    });
+                }
+            }
+            for ((body, state), contacts) in world
+                .bodies
+                .iter()
+                .zip(&solved.states)
+                .zip(&solved.contacts)
+            {
+                summary.residual = summary.residual.max(state.residual);
+                summary.overloaded += state.overloaded.len();
+                summary.max_displacement = state
+                    .displacements
+                    .iter()
+                    .map(|u| u.norm())
+                    .fold(summary.max_displacement, Real::max);
+                let mut written = BodyResult::new(body, state);
+                written.contacts = contact_forces(body, contacts);
+                result.bodies.push(written);
+            }
+            return Ok((result, summary));
+        }
         for (body, eq) in world.bodies.iter().zip(&self.equilibria) {
             let state =
                 eq.solve_step(body, step, world.steps)
@@ -118,20 +193,49 @@ impl<'w> Simulation<'w> {
 
     /// Model sizes for the summary.
     pub fn sizes(&self) -> Vec<BodySize> {
+        let contact = self
+            .contact
+            .as_ref()
+            .map(|c| c.lock().unwrap_or_else(|poisoned| poisoned.into_inner()));
         self.world
             .bodies
             .iter()
-            .zip(&self.equilibria)
-            .map(|(b, eq)| BodySize {
+            .enumerate()
+            .map(|(i, b)| BodySize {
                 name: b.name.clone(),
                 dimension: b.dimension.dofs_per_node(),
                 nodes: b.nodes.len(),
                 members: b.members.len(),
                 patches: b.patches.len(),
-                free_dofs: eq.free_dofs(),
-                solver: eq.solver_used().to_string(),
+                free_dofs: match (&contact, self.equilibria.get(i)) {
+                    (Some(c), _) => c.free_dofs(i),
+                    (None, Some(eq)) => eq.free_dofs(),
+                    (None, None) => 0,
+                },
+                solver: match (&contact, self.equilibria.get(i)) {
+                    (Some(_), _) => "direct".to_string(),
+                    (None, Some(eq)) => eq.solver_used().to_string(),
+                    (None, None) => String::new(),
+                },
             })
             .collect()
+    }
+
+    /// Time spent so far in each phase, s, summed over the bodies, and in contact queries.
+    fn times(&self) -> (PhaseTimes, Real) {
+        if let Some(c) = &self.contact {
+            let c = c.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+            return (c.times, c.query_seconds);
+        }
+        let mut sum = PhaseTimes::default();
+        for eq in &self.equilibria {
+            let t = eq.times();
+            sum.assembly += t.assembly;
+            sum.symbolic += t.symbolic;
+            sum.numeric += t.numeric;
+            sum.solve += t.solve;
+        }
+        (sum, 0.0)
     }
 }
 
@@ -196,6 +300,14 @@ pub fn run_with(
                     stopped = Some(RunError::Solve { scene, source });
                     break;
                 }
+                Err(RunError::Contact {
+                    scene,
+                    source: source @ ContactError::NotConverged { .. },
+                }) => {
+                    summary.failure = Some(source.to_string());
+                    stopped = Some(RunError::Contact { scene, source });
+                    break;
+                }
                 Err(e) => return Err(e),
             };
             line.seconds = t.elapsed().as_secs_f64() + if step == 1 { setup } else { 0.0 };
@@ -212,13 +324,12 @@ pub fn run_with(
             summary.steps.push(line);
             on_step();
         }
-        for eq in &simulation.equilibria {
-            let times = eq.times();
-            summary.phases.assembly += times.assembly;
-            summary.phases.symbolic += times.symbolic;
-            summary.phases.numeric += times.numeric;
-            summary.phases.solve += times.solve;
-        }
+        let (times, query) = simulation.times();
+        summary.phases.assembly += times.assembly;
+        summary.phases.symbolic += times.symbolic;
+        summary.phases.numeric += times.numeric;
+        summary.phases.solve += times.solve;
+        summary.phases.contact_query += query;
         write_extra_outputs(world, &staging, draw, &mut summary.phases)?;
         let path = staging.join("summary.json");
         let bytes = serde_json::to_vec_pretty(&summary).map_err(|e| RunError::Write {
@@ -236,6 +347,20 @@ pub fn run_with(
         let _ = std::fs::remove_dir_all(&staging);
     }
     result
+}
+
+/// The written form of a body's contacts: 1-based nodes, one force component per dimension.
+fn contact_forces(body: &Body, contacts: &[NodeContact]) -> Vec<ContactForce> {
+    let d = body.dimension.dofs_per_node();
+    contacts
+        .iter()
+        .map(|c| ContactForce {
+            node: c.node + 1,
+            with: c.with.clone(),
+            depth: c.depth,
+            force: c.force.as_slice()[..d].to_vec(),
+        })
+        .collect()
 }
 
 /// Put the complete folder `from` at `to`, replacing an earlier one.

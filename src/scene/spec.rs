@@ -22,6 +22,53 @@ pub struct SceneSpec {
     /// Which steps to write.
     #[serde(default)]
     pub output: OutputSpec,
+    /// Contact settings.
+    pub contact: Option<Spanned<ContactSpec>>,
+    /// Rigid obstacles.
+    #[serde(default)]
+    pub obstacles: Vec<Spanned<ObstacleSpec>>,
+}
+
+/// `[contact]`: penalty and tolerances (see `docs/SCENES.md`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Penalty stiffness, N/m of penetration (default: 100 × the mean E A / L of the body).
+    pub penalty: Option<Real>,
+    /// Penetration warned about, m (default: 1% of the mean member length).
+    pub tolerance: Option<Real>,
+    /// Contact iterations per step (default 50).
+    pub max_iterations: Option<usize>,
+}
+
+/// `[[obstacles]]`: a rigid obstacle (see `docs/SCENES.md`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleSpec {
+    /// Name, distinct from every body's and obstacle's name.
+    pub name: String,
+    /// `"half_space"`, `"cuboid"`, `"ball"`, `"cylinder"`, `"capsule"` or `"mesh"`.
+    pub shape: String,
+    /// A point on the boundary of a half-space, m.
+    pub point: Option<Vec<Real>>,
+    /// Outward normal of a half-space.
+    pub normal: Option<Vec<Real>>,
+    /// Centre of the other shapes, m.
+    pub center: Option<Vec<Real>>,
+    /// Half extents of a cuboid, m.
+    pub half_extents: Option<Vec<Real>>,
+    /// Radius of a ball, cylinder or capsule, m.
+    pub radius: Option<Real>,
+    /// Half length along the axis (local y) of a cylinder or capsule, m.
+    pub half_height: Option<Real>,
+    /// Rotation, degrees: about z in 2D (one number), a rotation vector (axis times angle) in 3D.
+    pub rotation: Option<Vec<Real>>,
+    /// Triangle mesh file of a `"mesh"` obstacle (OBJ or ASCII STL, m), relative to the scene.
+    pub file: Option<String>,
+    /// Translation reached at the last step, m.
+    pub travel: Option<Vec<Real>>,
+    /// Factor of the travel per step 1..=steps (default: linear ramp).
+    pub schedule: Option<Vec<Real>>,
 }
 
 fn one() -> usize {
@@ -80,6 +127,8 @@ pub struct BodySpec {
     pub cylindrical_shell: Option<ShellSpec>,
     /// Generated 3D box lattice.
     pub box_lattice: Option<LatticeSpec>,
+    /// Translation of the body's nodes (from files or a generator), m: places bodies in a scene.
+    pub offset: Option<Vec<Real>>,
     /// Supports.
     #[serde(default)]
     pub supports: Vec<Spanned<SupportSpec>>,

@@ -1,3 +1,4 @@
+use crate::contact::{ContactSettings, Obstacle};
 use crate::linkage::{Body, Schedule};
 use crate::scene::PictureSettings;
 use crate::Real;
@@ -37,6 +38,12 @@ pub struct World {
     pub steps: usize,
     /// The deformable bodies.
     pub bodies: Vec<Body>,
+    /// Rigid obstacles (`[[obstacles]]`).
+    pub obstacles: Vec<Obstacle>,
+    /// Contact settings (`[contact]`).
+    pub contact: ContactSettings,
+    /// Whether the scene has a `[contact]` table (contact between its bodies is looked for).
+    pub contact_table: bool,
     /// Which steps to write.
     pub output: OutputSettings,
     /// Pictures and VTK files to write.
@@ -46,6 +53,12 @@ pub struct World {
 }
 
 impl World {
+    /// Whether the scene is solved with contact: it has obstacles or a `[contact]` table. All
+    /// its bodies are then solved together, step by step ([`crate::contact::ContactSolver`]).
+    pub fn has_contact(&self) -> bool {
+        !self.obstacles.is_empty() || self.contact_table
+    }
+
     /// The load factor reported for `step`: the common schedule's factor when every load and
     /// prescribed displacement of the scene follows one schedule, else `step / steps`.
     pub fn load_factor(&self, step: usize) -> Real {

@@ -1,0 +1,121 @@
+//! Contact benchmark (issue 5): `cargo run --release --example bench_contact [--skip-pair]`.
+//!
+//! 1. Contact query time: one query iteration against a deformable surface of about 10,000 and
+//!    100,000 surface nodes: the oriented `TriMesh` rebuilt from the nodes, then every node of a
+//!    second, overlapping surface of the same size projected on it (inside test, nearest patch).
+//! 2. Two 3D boxes of about 20,000 nodes each pressed together (the lower one standing on its
+//!    base, the upper one held vertically by contact alone): time per load step split into
+//!    assembly, factorization, solves and contact queries, with Newton and contact iterations
+//!    and the equilibrium residual.
+
+use linkage::contact::PatchSurface;
+use linkage::linkage::{generators, Body, Material};
+use linkage::scene::{build_world, run};
+use nalgebra::Vector3;
+use std::path::Path;
+use std::time::Instant;
+
+fn slab(cells: usize) -> Body {
+    let g = generators::box_lattice([1.0, 1.0, 1.0 / cells as f64], [cells, cells, 1])
+        .expect("a valid lattice");
+    Body::from_geometry("slab", g, Material::new("m", 1e7, 1e-4))
+}
+
+fn query(cells: usize) {
+    let body = slab(cells);
+    let surface = PatchSurface::of(&body)
+        .expect("closed")
+        .expect("has patches");
+    let t = Instant::now();
+    let (mesh, _) = surface.mesh(|n| body.nodes[n]).expect("a mesh");
+    let build = t.elapsed().as_secs_f64();
+    // The second surface: the same slab shifted half its thickness down, so half its nodes
+    // are inside.
+    let shift = Vector3::new(0.0, 0.0, -0.5 / cells as f64);
+    let t = Instant::now();
+    let mut inside = 0;
+    for &n in &surface.nodes {
+        if PatchSurface::inside(&mesh, &(body.nodes[n] - shift)).is_some() {
+            inside += 1;
+        }
+    }
+    let project = t.elapsed().as_secs_f64();
+    println!(
+        "query  {:>7} surface nodes, {:>7} patches: mesh {:.4} s + {} projections {:.4} s = {:.4} s per query iteration ({} inside)",
+        surface.nodes.len(),
+        surface.patches.len(),
+        build,
+        surface.nodes.len(),
+        project,
+        build + project,
+        inside
+    );
+}
+
+fn pair(n: usize) {
+    let h = 0.1;
+    let scene = format!(
+        r#"
+name = "bench_pair"
+steps = 1
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "lower"
+box_lattice = {{ size = [0.2, {h}, 0.2], cells = [{n}, {n}, {n}] }}
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }}
+fix = ["x", "y", "z"]
+[[bodies]]
+name = "upper"
+box_lattice = {{ size = [0.2, {h}, 0.2], cells = [{n}, {n}, {n}] }}
+offset = [0.0, {h}, 0.0]
+[[bodies.supports]]
+on_line = {{ point = [0.0, {h}, 0.0], direction = [0.0, 1.0, 0.0] }}
+fix = ["x", "z"]
+[[bodies.supports]]
+on_line = {{ point = [0.2, {h}, 0.2], direction = [0.0, 1.0, 0.0] }}
+fix = ["x", "z"]
+[[bodies.loads]]
+on_plane = {{ point = [0.0, {top}, 0.0], normal = [0.0, 1.0, 0.0] }}
+total_force = [0.0, -500.0, 0.0]
+[contact]
+"#,
+        top = 2.0 * h
+    );
+    let world = build_world(&scene, Path::new("bench_pair.toml")).expect("a valid scene");
+    let out = tempfile::tempdir().expect("a temporary folder");
+    let t = Instant::now();
+    let summary = run(&world, out.path(), &|| {}).expect("solves");
+    let total = t.elapsed().as_secs_f64();
+    let step = &summary.steps[1];
+    let p = &summary.phases;
+    println!(
+        "pair   2 × {} nodes ({} free DOFs): step 1 {:.2} s ({} Newton, {} contact iterations, residual {:.1e}, max penetration {:.2e} m); run {:.2} s: assembly {:.2} s, ordering+symbolic {:.2} s, factorization {:.2} s, solves {:.2} s, contact queries {:.3} s",
+        summary.bodies[0].nodes,
+        summary.bodies.iter().map(|b| b.free_dofs).sum::<usize>(),
+        step.seconds,
+        step.iterations,
+        step.contact_iterations,
+        step.residual,
+        step.max_penetration,
+        total,
+        p.assembly,
+        p.symbolic,
+        p.numeric,
+        p.solve,
+        p.contact_query
+    );
+}
+
+fn main() {
+    // 2 (c + 1)² surface nodes: c = 70 gives 10,082; c = 223 gives 100,352.
+    query(70);
+    query(223);
+    if !std::env::args().any(|a| a == "--skip-pair") {
+        // 28 × 28 × 28 = 21,952 nodes per box.
+        pair(27);
+    }
+}

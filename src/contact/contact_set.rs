@@ -1,0 +1,96 @@
+//! The set of active contacts the settle loop iterates on, and the contacts reported per node.
+
+use crate::Real;
+use nalgebra::Vector3;
+
+/// A node held against a surface during one contact iteration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct ActiveContact {
+    /// Body of the node (index in the scene).
+    pub body: usize,
+    /// The node, 0-based.
+    pub node: usize,
+    /// What it presses on.
+    pub with: Target,
+}
+
+/// What a node presses on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Target {
+    /// An obstacle (index in the scene).
+    Obstacle(usize),
+    /// A boundary segment of a 2D body.
+    Segment {
+        /// The body (index in the scene).
+        body: usize,
+        /// The segment: from the i-th node of the body's boundary loop to the next.
+        segment: usize,
+    },
+    /// A surface patch of a 3D body.
+    Patch {
+        /// The body (index in the scene).
+        body: usize,
+        /// The patch (index in the body's patches).
+        patch: usize,
+    },
+    /// A boundary vertex of a 2D body, pressed along the mean normal of its two segments (a
+    /// node equally near both).
+    Vertex {
+        /// The body (index in the scene).
+        body: usize,
+        /// Position of the vertex in the body's boundary loop.
+        vertex: usize,
+    },
+}
+
+/// The active contacts, sorted: two sets compare equal when the same nodes touch the same
+/// surfaces (the settle loop stops there, and detects a set it has seen before).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ContactSet {
+    /// Sorted, without repeats.
+    pub contacts: Vec<ActiveContact>,
+}
+
+impl ContactSet {
+    /// A set from contacts in any order.
+    pub fn new(mut contacts: Vec<ActiveContact>) -> Self {
+        contacts.sort_unstable();
+        contacts.dedup();
+        ContactSet { contacts }
+    }
+
+    /// Number of active contacts.
+    pub fn len(&self) -> usize {
+        self.contacts.len()
+    }
+
+    /// Whether nothing touches.
+    pub fn is_empty(&self) -> bool {
+        self.contacts.is_empty()
+    }
+
+    /// Contacts in `self` and not in `other`, then in `other` and not in `self`.
+    pub fn difference(&self, other: &ContactSet) -> (Vec<ActiveContact>, Vec<ActiveContact>) {
+        let only = |a: &ContactSet, b: &ContactSet| {
+            a.contacts
+                .iter()
+                .filter(|c| b.contacts.binary_search(c).is_err())
+                .copied()
+                .collect::<Vec<_>>()
+        };
+        (only(self, other), only(other, self))
+    }
+}
+
+/// A node pressing on an obstacle or another body at a solved step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NodeContact {
+    /// The node, 0-based.
+    pub node: usize,
+    /// Name of the obstacle or body it touches.
+    pub with: String,
+    /// Penetration depth, m (≥ 0).
+    pub depth: Real,
+    /// Force the node receives, N.
+    pub force: Vector3<Real>,
+}

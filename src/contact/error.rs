@@ -1,0 +1,64 @@
+//! Why a scene with contact could not be solved.
+
+use crate::contact::SurfaceProblem;
+use crate::linkage::SolveError;
+use crate::Real;
+
+/// Why a contact step failed. Node numbers are 1-based.
+#[derive(Debug, thiserror::Error)]
+pub enum ContactError {
+    /// A body could not be prepared (validation, size).
+    #[error(transparent)]
+    Body(#[from] SolveError),
+    /// A body not held by its supports found no contacts that hold it.
+    #[error("step {step}: body '{body}' is not held by its supports and found no contact that holds it in {iterations} contact iterations ({contacts} contacts at the end): a load pushes it away from every surface, or the surface is far; support it, start it touching the surface, or raise [contact] max_iterations")]
+    Unsupported {
+        /// The step.
+        step: usize,
+        /// Body name.
+        body: String,
+        /// Contact iterations done.
+        iterations: usize,
+        /// Active contacts at the end.
+        contacts: usize,
+    },
+    /// Newton did not converge within one contact iteration.
+    #[error("step {step}: equilibrium with contact did not converge in {iterations} Newton iterations (relative residuals: [{}]): use more steps, or a smaller [contact] penalty", history.iter().map(|r| format!("{r:.1e}")).collect::<Vec<_>>().join(", "))]
+    NotConverged {
+        /// The step.
+        step: usize,
+        /// Newton iterations done.
+        iterations: usize,
+        /// Relative residual after each.
+        history: Vec<Real>,
+    },
+    /// The sparse factorization failed for another reason.
+    #[error("the sparse factorization of the bodies in contact failed: {0}")]
+    Factorization(String),
+    /// The arc-length method is not available with contact.
+    #[error("body '{body}': [bodies.path] method = \"arc_length\" cannot be combined with contact (obstacles or several bodies): use the default load schedules")]
+    ArcLength {
+        /// Body name.
+        body: String,
+    },
+    /// A 3D body's patches cannot be a contact surface.
+    #[error("body '{body}': its patches cannot be a contact surface: {}", match problem {
+        SurfaceProblem::NotClosed([a, b]) => format!("the edge from node {a} to node {b} belongs to one patch only (the surface is open); contact needs a closed surface: add the missing patches, or remove `patches`"),
+        SurfaceProblem::Inconsistent([a, b]) => format!("two patches run along the edge from node {a} to node {b} the same way, so they face opposite sides: list every patch counter-clockwise seen from outside"),
+    })]
+    Surface {
+        /// Body name.
+        body: String,
+        /// What is wrong.
+        problem: SurfaceProblem,
+    },
+    /// An obstacle could not be built.
+    #[error("an obstacle could not be built: {0}")]
+    Obstacle(String),
+    /// The result is not finite.
+    #[error("step {step}: the solution with contact is not finite: check the penalty ([contact] penalty) and the loads")]
+    NotFinite {
+        /// The step.
+        step: usize,
+    },
+}

@@ -1,0 +1,22 @@
+//! Contact between deformable bodies and rigid obstacles: obstacles held in rapier, penalty forces with their stiffness, and the settle loop.
+
+pub use self::boundary::boundary_loop;
+pub use self::contact_set::{ActiveContact, ContactSet, NodeContact, Target};
+pub use self::error::ContactError;
+pub use self::obstacle::{Obstacle, ObstacleShape};
+pub use self::obstacles::{mesh_collider, ObstacleProjection, Obstacles};
+pub use self::patch_surface::{PatchSurface, SurfaceProblem};
+pub use self::penalty::{default_penalty, penetration_tolerance, Penalty, PENALTY_FACTOR};
+pub use self::settings::ContactSettings;
+pub use self::settle::{ContactSolver, ContactStep};
+
+mod boundary;
+mod contact_set;
+mod coupled_system;
+mod error;
+mod obstacle;
+mod obstacles;
+mod patch_surface;
+mod penalty;
+mod settings;
+mod settle;

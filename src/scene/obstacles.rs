@@ -1,0 +1,179 @@
+//! Building the scene's rigid obstacles and contact settings from `[[obstacles]]` and
+//! `[contact]`.
+
+use crate::contact::{mesh_collider, ContactSettings, Obstacle, ObstacleShape};
+use crate::linkage::{Body, Dimension, Schedule};
+use crate::scene::mesh_file::read_mesh;
+use crate::scene::selector::vector;
+use crate::scene::spec::{ContactSpec, ObstacleSpec};
+use crate::Real;
+use nalgebra::Vector3;
+use std::path::Path;
+
+/// The obstacle described by `spec` in a scene of `dimension` with `steps` steps. Errors say
+/// what is wrong and what to do (the caller adds the file and line).
+pub(crate) fn obstacle_from(
+    spec: &ObstacleSpec,
+    dimension: Dimension,
+    steps: usize,
+    bodies: &[Body],
+    folder: &Path,
+) -> Result<Obstacle, String> {
+    let name = &spec.name;
+    let fail = |m: String| format!("obstacle '{name}': {m}");
+    if name.is_empty() {
+        return Err("an obstacle needs a name".to_string());
+    }
+    if bodies.iter().any(|b| &b.name == name) {
+        return Err(fail(
+            "a body has the same name: obstacles and bodies need distinct names (results name them in `with`)".to_string(),
+        ));
+    }
+    let point = |v: &Option<Vec<Real>>, key: &str| -> Result<Vector3<Real>, String> {
+        match v {
+            Some(v) => vector(v, dimension, key).map_err(fail),
+            None => Err(fail(format!("a {} needs `{key}`", spec.shape))),
+        }
+    };
+    let positive = |v: Option<Real>, key: &str| -> Result<Real, String> {
+        match v {
+            Some(x) if x.is_finite() && x > 0.0 => Ok(x),
+            Some(x) => Err(fail(format!("`{key}` = {x}: give a length > 0 (m)"))),
+            None => Err(fail(format!("a {} needs `{key}` (m)", spec.shape))),
+        }
+    };
+    let rotation = || -> Result<Vector3<Real>, String> {
+        let degrees = match (&spec.rotation, dimension) {
+            (None, _) => return Ok(Vector3::zeros()),
+            (Some(r), Dimension::Two) if r.len() == 1 => Vector3::new(0.0, 0.0, r[0]),
+            (Some(r), Dimension::Three) if r.len() == 3 => Vector3::new(r[0], r[1], r[2]),
+            (Some(r), _) => {
+                return Err(fail(format!(
+                    "`rotation` has {} components: give one angle about z in 2D, a rotation vector [x, y, z] in 3D (degrees)",
+                    r.len()
+                )))
+            }
+        };
+        if !degrees.iter().all(|x| x.is_finite()) {
+            return Err(fail("`rotation` is not finite".to_string()));
+        }
+        Ok(degrees.map(|x| x.to_radians()))
+    };
+    let shape = match spec.shape.as_str() {
+        "half_space" => {
+            let normal = point(&spec.normal, "normal")?;
+            if normal.norm() == 0.0 {
+                return Err(fail("`normal` must not be the zero vector".to_string()));
+            }
+            ObstacleShape::HalfSpace {
+                point: point(&spec.point, "point")?,
+                normal: normal.normalize(),
+            }
+        }
+        "cuboid" => {
+            let h = point(&spec.half_extents, "half_extents")?;
+            let d = dimension.dofs_per_node();
+            if h.as_slice()[..d].iter().any(|x| *x <= 0.0) {
+                return Err(fail("`half_extents` must all be > 0 (m)".to_string()));
+            }
+            // A 2D scene's cuboid is a rectangle: give it a depth that covers the plane.
+            let half_extents = if d == 2 {
+                Vector3::new(h.x, h.y, h.x.max(h.y))
+            } else {
+                h
+            };
+            ObstacleShape::Cuboid {
+                center: point(&spec.center, "center")?,
+                half_extents,
+                rotation: rotation()?,
+            }
+        }
+        "ball" => ObstacleShape::Ball {
+            center: point(&spec.center, "center")?,
+            radius: positive(spec.radius, "radius")?,
+        },
+        "cylinder" => ObstacleShape::Cylinder {
+            center: point(&spec.center, "center")?,
+            radius: positive(spec.radius, "radius")?,
+            half_height: positive(spec.half_height, "half_height")?,
+            rotation: rotation()?,
+        },
+        "capsule" => ObstacleShape::Capsule {
+            center: point(&spec.center, "center")?,
+            radius: positive(spec.radius, "radius")?,
+            half_height: positive(spec.half_height, "half_height")?,
+            rotation: rotation()?,
+        },
+        "mesh" => {
+            if dimension != Dimension::Three {
+                return Err(fail(
+                    "a mesh obstacle needs 3D bodies: in 2D use half_space, cuboid, ball, cylinder or capsule".to_string(),
+                ));
+            }
+            let Some(file) = &spec.file else {
+                return Err(fail(
+                    "a mesh needs `file`: an OBJ or ASCII STL file (m), relative to the scene file"
+                        .to_string(),
+                ));
+            };
+            let (vertices, triangles) = read_mesh(&folder.join(file))?;
+            let _checked = mesh_collider(&vertices, &triangles).map_err(&fail)?;
+            ObstacleShape::Mesh {
+                vertices,
+                triangles,
+            }
+        }
+        other => {
+            return Err(fail(format!(
+                "shape = {other:?}: use \"half_space\", \"cuboid\", \"ball\", \"cylinder\", \"capsule\" or \"mesh\""
+            )))
+        }
+    };
+    let travel = match &spec.travel {
+        Some(t) => vector(t, dimension, "travel").map_err(fail)?,
+        None => Vector3::zeros(),
+    };
+    let schedule = match &spec.schedule {
+        None => Schedule::Linear,
+        Some(f) if f.len() != steps => {
+            return Err(fail(format!(
+                "schedule has {} factors but the scene has {steps} steps: give one factor per step",
+                f.len()
+            )))
+        }
+        Some(f) if f.iter().any(|x| !x.is_finite()) => {
+            return Err(fail("schedule has a non-finite factor".to_string()))
+        }
+        Some(f) => Schedule::Factors(f.clone()),
+    };
+    Ok(Obstacle {
+        name: name.clone(),
+        shape,
+        travel,
+        schedule,
+    })
+}
+
+/// The contact settings of `[contact]` (defaults without it).
+pub(crate) fn contact_settings(spec: Option<&ContactSpec>) -> Result<ContactSettings, String> {
+    let mut settings = ContactSettings::default();
+    let Some(spec) = spec else {
+        return Ok(settings);
+    };
+    for (key, value) in [("penalty", spec.penalty), ("tolerance", spec.tolerance)] {
+        if let Some(v) = value {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("[contact] {key} = {v}: give a value > 0"));
+            }
+        }
+    }
+    settings.penalty = spec.penalty;
+    settings.tolerance = spec.tolerance;
+    if let Some(n) = spec.max_iterations {
+        if n == 0 {
+            return Err("[contact] max_iterations = 0: give 1 or more".to_string());
+        }
+        settings.max_iterations = n;
+    }
+    Ok(settings)
+}

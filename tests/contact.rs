@@ -1,0 +1,582 @@
+//! Contact with rigid obstacles (issue 5): numbers that follow from the penalty law and from
+//! equilibrium. Tolerances are stated where they are used.
+
+use linkage::scene::{build_world, load_scene, Simulation, StepResult, StepSummary};
+use std::path::{Path, PathBuf};
+
+/// Solve every step of `world` in order; the results and summaries.
+fn run_all(world: &linkage::scene::World) -> Vec<(StepResult, StepSummary)> {
+    let sim = Simulation::new(world).expect("builds");
+    (0..=world.steps)
+        .map(|k| sim.step(k).expect("solves"))
+        .collect()
+}
+
+/// A scene folder holding `files` (name, text); returns the folder and the scene path.
+fn scene_with(files: &[(&str, &str)], scene: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    (dir, path)
+}
+
+/// Sum over the bodies of reactions, loads and contact forces (N), and the largest of them.
+fn balance(result: &StepResult) -> ([f64; 3], f64) {
+    let mut sum = [0.0; 3];
+    let mut largest: f64 = 0.0;
+    for b in &result.bodies {
+        let forces = b
+            .reactions
+            .iter()
+            .map(|r| &r.force)
+            .chain(b.loads.iter().map(|l| &l.force))
+            .chain(b.contacts.iter().map(|c| &c.force));
+        for f in forces {
+            let n = f.iter().map(|x| x * x).sum::<f64>().sqrt();
+            largest = largest.max(n);
+            for (k, x) in f.iter().enumerate() {
+                sum[k] += x;
+            }
+        }
+    }
+    (sum, largest)
+}
+
+const BAR_NODES: &str = "0 0\n0 1\n";
+const BAR_LINKS: &str = "1 2\n";
+
+fn bar_on_floor(contact: &str) -> String {
+    format!(
+        r#"
+name = "bar_on_floor"
+steps = 2
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "bar"
+nodes = "bar.nodes"
+links = "bar.links"
+# Held sideways only: vertically the floor alone holds it.
+[[bodies.supports]]
+nodes = [1, 2]
+fix = ["x"]
+[[bodies.loads]]
+nodes = [2]
+force = [0.0, -1000.0]
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+{contact}
+"#
+    )
+}
+
+/// A vertical bar standing on a floor, pushed down by F at its top and held by nothing else
+/// vertically: its foot sinks exactly F / k into the floor (k the penalty), the floor pushes
+/// back with F, and the bar carries −F. Checked with the default penalty (100 E A / L) and an
+/// explicit one, at both steps (F/2 and F).
+#[test]
+fn bar_pressed_onto_floor_sinks_force_over_penalty() {
+    for (contact, k) in [
+        ("", 100.0 * 200e9 * 1e-4 / 1.0),
+        ("[contact]\npenalty = 1e6\n", 1e6),
+    ] {
+        let (_dir, path) = scene_with(
+            &[("bar.nodes", BAR_NODES), ("bar.links", BAR_LINKS)],
+            &bar_on_floor(contact),
+        );
+        let world = load_scene(&path).unwrap();
+        for (result, summary) in run_all(&world).into_iter().skip(1) {
+            let f = 1000.0 * result.load_factor;
+            let bar = &result.bodies[0];
+            assert_eq!(
+                bar.contacts.len(),
+                1,
+                "only the foot touches: {:?}",
+                bar.contacts
+            );
+            let c = &bar.contacts[0];
+            assert_eq!((c.node, c.with.as_str()), (1, "floor"));
+            // Exactly F / k: to round-off of the solve (1e-9 relative).
+            assert!(
+                (c.depth - f / k).abs() <= 1e-9 * f / k,
+                "depth {} vs F/k {}",
+                c.depth,
+                f / k
+            );
+            assert!((c.force[1] - f).abs() <= 1e-9 * f && c.force[0].abs() <= 1e-9 * f);
+            assert!((bar.axial_forces[0] + f).abs() <= 1e-9 * f);
+            assert!((summary.max_penetration - f / k).abs() <= 1e-9 * f / k);
+            assert!(summary.contact_iterations >= 1);
+            // The foot's displacement is the penetration: the floor is at y = 0.
+            assert!((bar.displacements[0][1] + f / k).abs() <= 1e-9 * f / k);
+        }
+    }
+}
+
+/// A flat block pressed from above by a ball that travels 1 cm down into it: every contact
+/// force points along the radius from the ball's centre to the node (radial normals), away
+/// from the centre, and its size is the penalty times the depth.
+#[test]
+fn ball_obstacle_gives_radial_contact_forces() {
+    let scene = r#"
+name = "ball_press"
+steps = 2
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "block"
+rectangle = { width = 1.0, height = 0.2, cells = [40, 8] }
+[[bodies.supports]]
+on_line = { point = [0.0, 0.0], direction = [1.0, 0.0] }
+fix = ["x", "y"]
+[[obstacles]]
+name = "ball"
+shape = "ball"
+center = [0.5, 0.5]
+radius = 0.3
+travel = [0.0, -0.01]
+"#;
+    let world = build_world(scene, Path::new("ball_press.toml")).unwrap();
+    let k = 100.0 * mean_member_stiffness(&world.bodies[0]);
+    for (result, summary) in run_all(&world).into_iter().skip(1) {
+        let block = &result.bodies[0];
+        let center = [0.5, 0.5 - 0.01 * result.load_factor];
+        assert!(block.contacts.len() >= 3, "{:?}", block.contacts);
+        for c in &block.contacts {
+            let p = &block.positions[c.node - 1];
+            let r = [p[0] - center[0], p[1] - center[1]];
+            let rn = (r[0] * r[0] + r[1] * r[1]).sqrt();
+            let f = &c.force;
+            let fn_ = (f[0] * f[0] + f[1] * f[1]).sqrt();
+            // Parallel to the radius and outward, to round-off.
+            assert!(
+                (f[0] * r[1] - f[1] * r[0]).abs() <= 1e-9 * fn_ * rn,
+                "{c:?}"
+            );
+            assert!(f[0] * r[0] + f[1] * r[1] > 0.0, "{c:?}");
+            // |f| = k · depth and depth = R − |x − c|.
+            assert!((fn_ - k * c.depth).abs() <= 1e-9 * fn_);
+            assert!((c.depth - (0.3 - rn)).abs() <= 1e-12);
+        }
+        let (sum, largest) = balance(&result);
+        for s in sum {
+            assert!(s.abs() <= 1e-8 * largest, "out of balance {sum:?}");
+        }
+        assert!(summary.residual <= 1e-8, "{summary:?}");
+    }
+}
+
+fn mean_member_stiffness(body: &linkage::linkage::Body) -> f64 {
+    let sum: f64 = body
+        .members
+        .iter()
+        .enumerate()
+        .map(|(m, member)| {
+            let mat = &body.materials[member.material];
+            mat.youngs_modulus * mat.area / body.member_length(m)
+        })
+        .sum();
+    sum / body.members.len() as f64
+}
+
+/// The bundled disk_on_floor scene: at every step the supports' reactions, the loads and the
+/// floor's contact forces sum to zero (to 1e-8 of the largest), each contact force is the
+/// penalty times its depth along +y, and no node is deeper than the tolerance (1% of the mean
+/// member length).
+#[test]
+fn disk_on_floor_is_in_equilibrium() {
+    let world = load_scene(Path::new("scenes/disk_on_floor.toml")).unwrap();
+    let body = &world.bodies[0];
+    let k = 100.0 * mean_member_stiffness(body);
+    let mean_length: f64 = (0..body.members.len())
+        .map(|m| body.member_length(m))
+        .sum::<f64>()
+        / body.members.len() as f64;
+    let mut touched = 0;
+    for (result, summary) in run_all(&world) {
+        let (sum, largest) = balance(&result);
+        for s in sum {
+            assert!(
+                s.abs() <= 1e-8 * largest.max(1e-300),
+                "step {}: {sum:?}",
+                result.step
+            );
+        }
+        for c in &result.bodies[0].contacts {
+            assert!(c.force[0].abs() <= 1e-9 * c.force[1]);
+            assert!((c.force[1] - k * c.depth).abs() <= 1e-9 * c.force[1]);
+            assert!(c.depth <= 0.01 * mean_length);
+        }
+        touched = touched.max(result.bodies[0].contacts.len());
+        assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
+    }
+    assert!(
+        touched >= 3,
+        "the disk flattens onto several nodes: {touched}"
+    );
+}
+
+/// Obstacles are checked like everything else: the file, the line and what to do.
+#[test]
+fn bad_obstacles_are_reported_with_line() {
+    let base = r#"
+name = "s"
+[[materials]]
+name = "m"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "disk"
+disk = { radius = 0.1 }
+[[bodies.supports]]
+nodes = [1]
+fix = ["x", "y"]
+"#;
+    let cases = [
+        (
+            "[[obstacles]]\nname = \"disk\"\nshape = \"ball\"\ncenter = [0.0, 0.0]\nradius = 1.0\n",
+            "distinct names",
+        ),
+        (
+            "[[obstacles]]\nname = \"o\"\nshape = \"cone\"\n",
+            "shape = \"cone\"",
+        ),
+        (
+            "[[obstacles]]\nname = \"o\"\nshape = \"ball\"\ncenter = [0.0, 0.0, 1.0]\nradius = 1.0\n",
+            "3 components",
+        ),
+        (
+            "[[obstacles]]\nname = \"o\"\nshape = \"half_space\"\npoint = [0.0, 0.0]\nnormal = [0.0, 0.0]\n",
+            "zero vector",
+        ),
+        ("[contact]\npenalty = -1.0\n", "penalty = -1"),
+    ];
+    for (extra, expected) in cases {
+        let text = format!("{base}{extra}");
+        let err = build_world(&text, Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(expected), "{err}");
+        assert!(
+            err.starts_with("s.toml:1"),
+            "names the file and line: {err}"
+        );
+    }
+}
+
+/// The bundled two_disks scene: two equal disks pressed together by equal and opposite forces,
+/// held sideways by nothing but each other. At every loaded step the contact forces on each
+/// disk sum to minus its applied load (to 1e-6 relative) and are equal and opposite between the
+/// disks; no node is deeper than the tolerance (1% of the mean member length); the
+/// displacements are mirror images about x = 0 (to 1e-6 of the largest); the contact zone is
+/// centred on the line of centres (y = 0).
+#[test]
+fn two_disks_press_each_other_symmetrically() {
+    let world = load_scene(Path::new("scenes/two_disks.toml")).unwrap();
+    let body = &world.bodies[0];
+    let mean_length: f64 = (0..body.members.len())
+        .map(|m| body.member_length(m))
+        .sum::<f64>()
+        / body.members.len() as f64;
+    for (result, summary) in run_all(&world).into_iter().skip(1) {
+        let f = 400.0 * result.load_factor;
+        let [left, right] = [&result.bodies[0], &result.bodies[1]];
+        let sum = |b: &linkage::scene::BodyResult| {
+            b.contacts
+                .iter()
+                .fold([0.0, 0.0], |s, c| [s[0] + c.force[0], s[1] + c.force[1]])
+        };
+        let (l, r) = (sum(left), sum(right));
+        assert!(
+            (l[0] + f).abs() <= 1e-6 * f && l[1].abs() <= 1e-6 * f,
+            "left {l:?}, load {f}"
+        );
+        assert!(
+            (r[0] - f).abs() <= 1e-6 * f && r[1].abs() <= 1e-6 * f,
+            "right {r:?}"
+        );
+        assert!((l[0] + r[0]).abs() <= 1e-9 * f, "equal and opposite");
+        // The summary's total per pair says the same.
+        let pair = |body: &str| {
+            summary
+                .contact_forces
+                .iter()
+                .find(|p| p.body == body)
+                .unwrap_or_else(|| panic!("a total for {body}: {:?}", summary.contact_forces))
+                .clone()
+        };
+        let (pl, pr) = (pair("left"), pair("right"));
+        assert_eq!((pl.with.as_str(), pr.with.as_str()), ("right", "left"));
+        assert!((pl.force[0] - l[0]).abs() <= 1e-9 * f && (pr.force[0] - r[0]).abs() <= 1e-9 * f);
+        for c in left.contacts.iter().chain(&right.contacts) {
+            assert!(c.depth <= 0.01 * mean_length, "{c:?}");
+        }
+        assert!(summary.max_penetration <= 0.01 * mean_length);
+        // Mirror images: node i of the left disk at (x, y) has its twin at (−x, y).
+        let largest = left
+            .displacements
+            .iter()
+            .map(|u| u[0].hypot(u[1]))
+            .fold(0.0, f64::max);
+        let nodes_l = &world.bodies[0].nodes;
+        let nodes_r = &world.bodies[1].nodes;
+        for (i, p) in nodes_l.iter().enumerate() {
+            let j = nodes_r
+                .iter()
+                .position(|q| (q.x + p.x).abs() < 1e-12 && (q.y - p.y).abs() < 1e-12)
+                .expect("a mirror twin");
+            let (ul, ur) = (&left.displacements[i], &right.displacements[j]);
+            assert!(
+                (ul[0] + ur[0]).abs() <= 1e-6 * largest && (ul[1] - ur[1]).abs() <= 1e-6 * largest,
+                "node {}: {ul:?} vs twin {}: {ur:?}",
+                i + 1,
+                j + 1
+            );
+        }
+        // Centred on y = 0: the force-weighted mean height of the contact nodes.
+        let (mut moment, mut total) = (0.0, 0.0);
+        for c in &left.contacts {
+            let p = &left.positions[c.node - 1];
+            let size = c.force[0].hypot(c.force[1]);
+            moment += size * p[1];
+            total += size;
+        }
+        assert!(total > 0.0 && (moment / total).abs() <= 1e-9 * mean_length);
+        if result.step == world.steps {
+            assert!(left.contacts.len() >= 3, "a contact zone, not a point");
+        }
+    }
+}
+
+/// shell_on_block and its moving variant: at every step the support reactions, the applied
+/// force and the block's contact forces balance (to 1e-8 of the largest), and every contact
+/// node lies on the block's top face (its y within the tolerance, 1% of the mean member length,
+/// of the face, which rises with the block's travel in the moving variant).
+#[test]
+fn shell_on_block_balances_and_rests_on_the_face() {
+    for (scene, top, rise) in [
+        ("scenes/shell_on_block.toml", -0.2502, 0.0),
+        ("scenes/shell_on_block_moving.toml", -0.25, 0.02),
+    ] {
+        let world = load_scene(Path::new(scene)).unwrap();
+        let body = &world.bodies[0];
+        let tolerance = 0.01
+            * (0..body.members.len())
+                .map(|m| body.member_length(m))
+                .sum::<f64>()
+            / body.members.len() as f64;
+        let mut touched = false;
+        for (result, summary) in run_all(&world) {
+            let (sum, largest) = balance(&result);
+            for s in sum {
+                assert!(s.abs() <= 1e-8 * largest.max(1e-300), "{scene}: {sum:?}");
+            }
+            let face = top + rise * result.load_factor;
+            let shell = &result.bodies[0];
+            for c in &shell.contacts {
+                let y = shell.positions[c.node - 1][1];
+                assert!(
+                    (y - face).abs() <= tolerance,
+                    "{scene}: node {} at {y}",
+                    c.node
+                );
+                assert!(c.force[1] > 0.0 && c.force[0] == 0.0 && c.force[2] == 0.0);
+                touched = true;
+            }
+            assert!(summary.residual <= 1e-8, "{scene}: {summary:?}");
+        }
+        assert!(touched, "{scene}: the shell reaches the block");
+    }
+}
+
+/// The bundled stack of three 3D boxes: the two upper boxes are held vertically by contact alone
+/// and settle; at every step each interface carries the whole load (the summary's pair totals,
+/// vertical part, to 1e-6), equal and opposite across it, and reactions, loads and contact
+/// forces balance (to 1e-8 of the largest).
+#[test]
+fn stack_of_three_boxes_passes_the_load_down() {
+    let world = load_scene(Path::new("scenes/stack.toml")).unwrap();
+    for (result, summary) in run_all(&world).into_iter().skip(1) {
+        let load = 500.0 * result.load_factor;
+        let (sum, largest) = balance(&result);
+        for s in sum {
+            assert!(s.abs() <= 1e-8 * largest, "{sum:?}");
+        }
+        let total = |body: &str, with: &str| -> Vec<f64> {
+            summary
+                .contact_forces
+                .iter()
+                .find(|p| p.body == body && p.with == with)
+                .unwrap_or_else(|| panic!("{body} on {with}: {:?}", summary.contact_forces))
+                .force
+                .clone()
+        };
+        for (upper, lower) in [("middle", "bottom"), ("top", "middle")] {
+            let up = total(upper, lower);
+            let down = total(lower, upper);
+            assert!(
+                (up[1] - load).abs() <= 1e-6 * load,
+                "{upper} on {lower}: {up:?}"
+            );
+            for k in 0..3 {
+                assert!((up[k] + down[k]).abs() <= 1e-9 * load, "equal and opposite");
+            }
+        }
+        assert!(summary.residual <= 1e-9, "{summary:?}");
+    }
+}
+
+/// Contact with large displacements: disk_on_floor with `kinematics = "large"` still balances
+/// at every step (to 1e-8 of the largest force) and the floor pushes straight up.
+#[test]
+fn large_displacement_disk_on_floor_balances() {
+    let text = std::fs::read_to_string("scenes/disk_on_floor.toml")
+        .unwrap()
+        .replace(
+            "disk = { radius = 0.1, rings = 6, sectors = 32 }",
+            "disk = { radius = 0.1, rings = 6, sectors = 32 }\nkinematics = \"large\"",
+        );
+    assert!(text.contains("kinematics = \"large\""));
+    let world = build_world(&text, Path::new("scenes/disk_on_floor.toml")).unwrap();
+    for (result, summary) in run_all(&world).into_iter().skip(1) {
+        let (sum, largest) = balance(&result);
+        for s in sum {
+            assert!(s.abs() <= 1e-8 * largest, "{sum:?}");
+        }
+        assert!(!result.bodies[0].contacts.is_empty());
+        for c in &result.bodies[0].contacts {
+            assert!(c.force[0].abs() <= 1e-9 * c.force[1]);
+        }
+        assert!(summary.residual <= 1e-9);
+    }
+}
+
+/// A unit cube given as an OBJ triangle mesh (counter-clockwise seen from outside) acts exactly
+/// like the same cube as a cuboid obstacle: a 3D box pressed onto it gets the same contacts and
+/// displacements (to 1e-9 of the largest).
+#[test]
+fn mesh_obstacle_matches_the_cuboid() {
+    let cube_obj = "\
+v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n\
+v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+    let scene = |obstacle: &str| {
+        format!(
+            r#"
+name = "box_on_cube"
+steps = 2
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "box"
+box_lattice = {{ size = [0.2, 0.1, 0.2], cells = [2, 2, 2] }}
+offset = [-0.1, 0.5, -0.1]
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.6, 0.0], normal = [0.0, 1.0, 0.0] }}
+fix = ["x", "y", "z"]
+displacement = [0.0, -0.002, 0.0]
+[[obstacles]]
+name = "cube"
+{obstacle}
+"#
+        )
+    };
+    let (_dir, mesh_path) = scene_with(
+        &[("cube.obj", cube_obj)],
+        &scene("shape = \"mesh\"\nfile = \"cube.obj\""),
+    );
+    let with_mesh = run_all(&load_scene(&mesh_path).unwrap());
+    let cuboid = build_world(
+        &scene("shape = \"cuboid\"\ncenter = [0.0, 0.0, 0.0]\nhalf_extents = [0.5, 0.5, 0.5]"),
+        Path::new("box_on_cube.toml"),
+    )
+    .unwrap();
+    let with_cuboid = run_all(&cuboid);
+    let (a, b) = (&with_mesh[2].0.bodies[0], &with_cuboid[2].0.bodies[0]);
+    assert_eq!(a.contacts.len(), 9, "the bottom face's 3 × 3 nodes");
+    assert_eq!(a.contacts.len(), b.contacts.len());
+    let largest = b
+        .displacements
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    for (u, v) in a
+        .displacements
+        .iter()
+        .flatten()
+        .zip(b.displacements.iter().flatten())
+    {
+        assert!((u - v).abs() <= 1e-9 * largest);
+    }
+}
+
+/// Bad contact input is reported before anything is solved: a missing mesh file names the file,
+/// and a 3D body whose patches face both ways names the edge where they disagree.
+#[test]
+fn bad_mesh_file_and_inconsistent_patches_are_reported() {
+    let base = r#"
+name = "s"
+[[materials]]
+name = "m"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "box"
+nodes = "box.nodes"
+links = "box.links"
+patches = "box.patches"
+[[bodies.supports]]
+nodes = [1, 2, 3]
+fix = ["x", "y", "z"]
+"#;
+    // A tetrahedron; its last patch is listed clockwise.
+    let nodes = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+    let links = "1 2\n1 3\n1 4\n2 3\n2 4\n3 4\n";
+    let patches = "1 3 2\n1 2 4\n2 3 4\n1 4 3\n";
+    let broken = "1 3 2\n1 2 4\n2 3 4\n1 3 4\n";
+    let files = |p: &'static str| {
+        [
+            ("box.nodes", nodes),
+            ("box.links", links),
+            ("box.patches", p),
+        ]
+    };
+    let missing =
+        format!("{base}[[obstacles]]\nname = \"o\"\nshape = \"mesh\"\nfile = \"nowhere.obj\"\n");
+    let (_dir, path) = scene_with(&files(patches), &missing);
+    let err = load_scene(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("nowhere.obj") && err.contains("cannot read"),
+        "{err}"
+    );
+
+    let with_contact = format!("{base}[contact]\n");
+    let (_dir, path) = scene_with(&files(patches), &with_contact);
+    let world = load_scene(&path).unwrap();
+    assert!(
+        Simulation::new(&world).is_ok(),
+        "a consistent closed surface"
+    );
+    let (_dir, path) = scene_with(&files(broken), &with_contact);
+    let world = load_scene(&path).unwrap();
+    let err = match Simulation::new(&world) {
+        Ok(_) => panic!("inconsistent patches must be reported"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("body 'box'") && err.contains("counter-clockwise"),
+        "{err}"
+    );
+}
