@@ -295,9 +295,16 @@ fn run_scenes(
                 );
                 let p = &summary.phases;
                 println!(
-                    "      phases: assembly {:.3} s, ordering+symbolic {:.3} s, factorization {:.3} s, solve {:.3} s, writing {:.3} s",
-                    p.assembly, p.symbolic, p.numeric, p.solve, p.writing
+                    "      phases: assembly {:.3} s, ordering+symbolic {:.3} s, factorization {:.3} s, solve {:.3} s, writing {:.3} s, drawing {:.3} s",
+                    p.assembly, p.symbolic, p.numeric, p.solve, p.writing, p.drawing
                 );
+                // The summary's warnings (deep penetration, an unsettled contact set) matter
+                // enough to show here, not only in summary.json.
+                for step in &summary.steps {
+                    for w in &step.warnings {
+                        println!("warn  {}: {w}", world.name);
+                    }
+                }
             }
             Err(e) => {
                 failed += 1;
