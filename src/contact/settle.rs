@@ -18,8 +18,8 @@ use crate::contact::{
 };
 use crate::linkage::cholesky::CholeskyError;
 use crate::linkage::{
-    member_response, post_process, Body, DofMap, PathMethod, PhaseTimes, Schedule, SolveError,
-    StepState, StiffnessAssembly,
+    member_response, post_process, prescribed_displacements, Body, DofMap, PathMethod, PhaseTimes,
+    SolveError, StepState, StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
@@ -1097,36 +1097,9 @@ fn loads_at(body: &Body, step: usize, steps: usize) -> Vec<Real> {
     f
 }
 
-/// Prescribed displacement per body DOF at `step`, m: grouped by schedule as the linear solve
-/// does (within one schedule a later support's value replaces an earlier one's; schedules add).
+/// Prescribed displacement per body DOF at `step`, m (see [`prescribed_displacements`]).
 fn prescribed_at(body: &Body, step: usize, steps: usize) -> Vec<Real> {
-    let d = body.dimension.dofs_per_node();
-    let mut patterns: Vec<(&Schedule, Vec<Real>)> = Vec::new();
-    for s in &body.supports {
-        if s.displacement == Vector3::zeros() {
-            continue;
-        }
-        let p = match patterns.iter().position(|(sched, _)| *sched == &s.schedule) {
-            Some(p) => p,
-            None => {
-                patterns.push((&s.schedule, vec![0.0; body.dof_count()]));
-                patterns.len() - 1
-            }
-        };
-        for k in 0..d {
-            if s.fixed[k] {
-                patterns[p].1[s.node * d + k] = s.displacement[k];
-            }
-        }
-    }
-    let mut u = vec![0.0; body.dof_count()];
-    for (schedule, values) in patterns {
-        let factor = schedule.factor(step, steps);
-        for (a, b) in u.iter_mut().zip(values) {
-            *a += factor * b;
-        }
-    }
-    u
+    prescribed_displacements(body, |schedule| schedule.factor(step, steps))
 }
 
 fn norm(v: &[Real]) -> Real {

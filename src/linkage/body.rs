@@ -551,3 +551,37 @@ pub fn bounding_diagonal(points: &[Vector3<Real>]) -> Real {
         (hi - lo).norm()
     }
 }
+
+/// Prescribed displacement per body DOF, m (zero at free DOFs), with each support's schedule
+/// weighted by `factor`. Supports are grouped by schedule as the linear solve groups them:
+/// within one schedule a later support's value of a DOF replaces an earlier one's; different
+/// schedules add up.
+pub fn prescribed_displacements(body: &Body, factor: impl Fn(&Schedule) -> Real) -> Vec<Real> {
+    let d = body.dimension.dofs_per_node();
+    let mut patterns: Vec<(&Schedule, Vec<Real>)> = Vec::new();
+    for s in &body.supports {
+        if s.displacement == Vector3::zeros() {
+            continue;
+        }
+        let p = match patterns.iter().position(|(sched, _)| *sched == &s.schedule) {
+            Some(p) => p,
+            None => {
+                patterns.push((&s.schedule, vec![0.0; body.dof_count()]));
+                patterns.len() - 1
+            }
+        };
+        for k in 0..d {
+            if s.fixed[k] {
+                patterns[p].1[s.node * d + k] = s.displacement[k];
+            }
+        }
+    }
+    let mut u = vec![0.0; body.dof_count()];
+    for (schedule, values) in patterns {
+        let f = factor(schedule);
+        for (a, b) in u.iter_mut().zip(values) {
+            *a += f * b;
+        }
+    }
+    u
+}

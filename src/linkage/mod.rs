@@ -5,8 +5,8 @@ pub use self::assembly::ModelTooLarge;
 pub use self::assembly::StiffnessAssembly;
 pub use self::block_jacobi::{BlockJacobi, SingularBlock};
 pub use self::body::{
-    bounding_diagonal, check_members, Body, BodyError, Dimension, Member, MemberProblem, NodalLoad,
-    Schedule, Support,
+    bounding_diagonal, check_members, prescribed_displacements, Body, BodyError, Dimension, Member,
+    MemberProblem, NodalLoad, Schedule, Support,
 };
 pub use self::body_solver::BodySolver;
 pub use self::conjugate_gradient::{conjugate_gradient, CgReport, CgSettings};

@@ -9,8 +9,8 @@ use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::step_state::{force_scale, post_process};
 use crate::linkage::tangent_solver::{TangentError, TangentSolver};
 use crate::linkage::{
-    direction_name, member_response, Body, DofMap, MemberResponse, PathMethod, PhaseTimes,
-    Schedule, SolveError, StepState, StiffnessAssembly,
+    direction_name, member_response, prescribed_displacements, Body, DofMap, MemberResponse,
+    PathMethod, PhaseTimes, Schedule, SolveError, StepState, StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
@@ -282,35 +282,7 @@ impl NewtonEquilibrium {
 
     /// Prescribed displacement per body DOF at pseudo-time `t`, m (zero at free DOFs).
     fn prescribed_at(&self, body: &Body, t: Real, steps: usize) -> Vec<Real> {
-        // Grouped by schedule as the linear solve does (`Equilibrium`): within one schedule a
-        // later support's value of a DOF replaces an earlier one's, different schedules add up.
-        let d = self.dofs.dofs_per_node;
-        let mut patterns: Vec<(&Schedule, Vec<Real>)> = Vec::new();
-        for s in &body.supports {
-            if s.displacement == Vector3::zeros() {
-                continue;
-            }
-            let p = match patterns.iter().position(|(sched, _)| *sched == &s.schedule) {
-                Some(p) => p,
-                None => {
-                    patterns.push((&s.schedule, vec![0.0; body.dof_count()]));
-                    patterns.len() - 1
-                }
-            };
-            for k in 0..d {
-                if s.fixed[k] {
-                    patterns[p].1[s.node * d + k] = s.displacement[k];
-                }
-            }
-        }
-        let mut u = vec![0.0; body.dof_count()];
-        for (schedule, values) in patterns {
-            let factor = factor_at(schedule, t, steps);
-            for (a, b) in u.iter_mut().zip(values) {
-                *a += factor * b;
-            }
-        }
-        u
+        prescribed_displacements(body, |schedule| factor_at(schedule, t, steps))
     }
 
     fn fill_tangent(&mut self, body: &Body) {
