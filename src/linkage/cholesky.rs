@@ -471,7 +471,7 @@ fn check_lower_pattern(
 }
 
 /// Position of each diagonal entry L_jj (permuted column j) in faer's value buffer.
-fn factor_diagonal_positions(symbolic: &SymbolicCholesky<usize>) -> Vec<usize> {
+pub(crate) fn factor_diagonal_positions(symbolic: &SymbolicCholesky<usize>) -> Vec<usize> {
     match symbolic.raw() {
         // Simplicial: CSC, the diagonal opens each column.
         SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr()[..s.nrows()].to_vec(),

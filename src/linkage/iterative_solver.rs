@@ -30,8 +30,6 @@ pub(crate) struct IterativeSolver {
     history: std::collections::VecDeque<(Vec<Real>, Vec<Real>)>,
     /// Conjugate-gradient iterations, all solves.
     pub iterations: usize,
-    /// The report of the last solve.
-    pub last: Option<CgReport>,
 }
 
 impl IterativeSolver {
@@ -54,7 +52,6 @@ impl IterativeSolver {
             stale: false,
             history: std::collections::VecDeque::new(),
             iterations: 0,
-            last: None,
         }
     }
 
@@ -122,7 +119,6 @@ impl IterativeSolver {
         } else if self.fresh_iterations.is_none() {
             self.fresh_iterations = Some(report.iterations);
         }
-        self.last = Some(report);
         if report.converged && self.settings.warm_start {
             if self.history.len() == WARM_START_VECTORS {
                 self.history.pop_front();

@@ -7,7 +7,7 @@
 //!
 //! No pivoting: a pivot that is exactly zero (a singular tangent, a mechanism) is an error.
 
-use crate::linkage::cholesky::{CholeskyError, SparseCholesky};
+use crate::linkage::cholesky::{factor_diagonal_positions, CholeskyError, SparseCholesky};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
 use faer::perm::PermRef;
@@ -67,7 +67,7 @@ impl SparseLdlt {
             .try_reserve_exact(symbolic.len_val())
             .map_err(|_| CholeskyError::Resources("LDLᵀ factor".to_string()))?;
         l_values.resize(symbolic.len_val(), 0.0);
-        let d_diag = diagonal_positions(&symbolic);
+        let d_diag = factor_diagonal_positions(&symbolic);
         Ok(SparseLdlt {
             n,
             pattern,
@@ -137,25 +137,6 @@ impl SparseLdlt {
             Par::Seq,
             MemStack::new(&mut self.mem),
         );
-    }
-}
-
-/// Position of each diagonal entry (permuted column j) in faer's value buffer: the same
-/// layout as for LLᵀ (see `cholesky.rs`).
-fn diagonal_positions(symbolic: &SymbolicCholesky<usize>) -> Vec<usize> {
-    match symbolic.raw() {
-        SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr()[..s.nrows()].to_vec(),
-        SymbolicCholeskyRaw::Supernodal(s) => {
-            let mut pos = Vec::with_capacity(s.nrows());
-            let bounds = s.supernode_begin().iter().zip(s.supernode_end());
-            for (k, (&start, &end)) in bounds.enumerate() {
-                let width = end - start;
-                let rows = width + s.supernode(k).pattern().len();
-                let base = s.col_ptr_for_val()[k];
-                pos.extend((0..width).map(|c| base + c * rows + c));
-            }
-            pos
-        }
     }
 }
 
