@@ -14,7 +14,10 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 use rayon::iter::ParallelExtend;
 
-use super::ordering::{expand_to_dofs, graph_of_pattern, nested_dissection, OrderingError};
+use super::ordering::{
+    expand_to_dofs, graph_of_pattern, nested_dissection, nested_dissection_with_trailing,
+    OrderingError,
+};
 
 /// Default smallest accepted pivot ratio `d_j / A_jj` (dimensionless): below it the
 /// matrix is treated as singular to working precision.
@@ -214,6 +217,48 @@ impl SparseCholesky {
             FillOrdering::Identity => Some(((0..n).collect(), (0..n).collect())),
             FillOrdering::Amd => None,
         };
+        Self::analyze_ordered(n, col_ptr, row_idx, custom, options)
+    }
+
+    /// Symbolic analysis with the DOFs of the nodes marked `trailing` (`trailing[node]`,
+    /// `groups[dof] = node`) ordered last and the others by METIS nested dissection, in the
+    /// supernodal layout: the last block of the factor is then the Cholesky factor of the
+    /// Schur complement on the trailing DOFs ([`trailing_factor`](Self::trailing_factor)).
+    pub fn analyze_trailing(
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        groups: &[usize],
+        trailing: &[bool],
+        threads: usize,
+    ) -> Result<Self, CholeskyError> {
+        check_lower_pattern(n, col_ptr, row_idx)?;
+        if groups.len() != n {
+            return Err(CholeskyError::InvalidInput(format!(
+                "{} group entries for {n} DOFs",
+                groups.len()
+            )));
+        }
+        let n_nodes = trailing.len();
+        let (xadj, adjncy) = graph_of_pattern(n, col_ptr, row_idx, Some(groups), n_nodes)?;
+        let (node_perm, _) = nested_dissection_with_trailing(&xadj, &adjncy, trailing)?;
+        let custom = Some(expand_to_dofs(&node_perm, groups)?);
+        let options = CholeskyOptions {
+            ordering: FillOrdering::NestedDissection,
+            layout: FactorLayout::Supernodal,
+            threads,
+        };
+        Self::analyze_ordered(n, col_ptr, row_idx, custom, options)
+    }
+
+    /// The symbolic analysis proper, with `custom = Some((perm, inv))` or AMD.
+    fn analyze_ordered(
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        custom: Option<(Vec<usize>, Vec<usize>)>,
+        options: CholeskyOptions,
+    ) -> Result<Self, CholeskyError> {
         let ordering = match &custom {
             Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
             None => SymmetricOrdering::Amd,
@@ -404,6 +449,42 @@ impl SparseCholesky {
     /// [`solve_in_place`](Self::solve_in_place) may be called.
     pub fn is_factorized(&self) -> bool {
         self.factorized
+    }
+
+    /// The last `m` columns of the factor: the original DOFs of factor columns `n − m..n`,
+    /// and the dense lower-triangular block `L₂₂` of those rows and columns, for which
+    /// `L₂₂ L₂₂ᵀ = A₂₂ − A₂₁ A₁₁⁻¹ A₁₂`, the Schur complement on those DOFs (N/m for a
+    /// stiffness). `None` before a successful factorization or for a simplicial factor.
+    pub fn trailing_factor(&self, m: usize) -> Option<(Vec<usize>, faer::Mat<f64>)> {
+        if !self.factorized || m > self.n {
+            return None;
+        }
+        let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
+            return None;
+        };
+        let first = self.n - m;
+        let mut block = faer::Mat::<f64>::zeros(m, m);
+        let bounds = s.supernode_begin().iter().zip(s.supernode_end());
+        for (k, (&start, &end)) in bounds.enumerate() {
+            if end <= first {
+                continue;
+            }
+            let width = end - start;
+            let pattern = s.supernode(k).pattern();
+            let rows = width + pattern.len();
+            let base = s.col_ptr_for_val()[k];
+            for col in start.max(first)..end {
+                let c = col - start;
+                let values = &self.l_values[base + c * rows..base + (c + 1) * rows];
+                for (r, &v) in values.iter().enumerate().take(width).skip(c) {
+                    block[(start + r - first, col - first)] = v;
+                }
+                for (&row, &v) in pattern.iter().zip(&values[width..]) {
+                    block[(row - first, col - first)] = v;
+                }
+            }
+        }
+        Some((self.perm[first..].to_vec(), block))
     }
 
     /// Maps faer's failed-pivot index to the permuted column.
@@ -621,6 +702,72 @@ mod tests {
             let res = sym_mul(&c, &r, &v, &x);
             assert!(rel_err(&res, &b) < 1e-12);
         }
+    }
+
+    /// The trailing block of the factor reproduces the Schur complement, computed densely
+    /// from the solves `A₁₁⁻¹ A₁₂` column by column.
+    #[test]
+    fn trailing_block_is_the_factor_of_the_schur_complement() {
+        // Pairs of DOFs per "node" so that groups matter; the trailing nodes are a stripe.
+        let (nx, ny) = (9, 7);
+        let (n1, c1, r1, v1) = laplacian_2d(nx, ny, 0.3);
+        let mut e = Vec::new();
+        for j in 0..n1 {
+            for p in c1[j]..c1[j + 1] {
+                for k in 0..2 {
+                    e.push((2 * r1[p] + k, 2 * j + k, v1[p] * (1.0 + k as f64)));
+                }
+            }
+            e.push((2 * j + 1, 2 * j, 0.5));
+        }
+        let n = 2 * n1;
+        let (col_ptr, rows, vals) = lower_csc(n, e);
+        let groups: Vec<usize> = (0..n).map(|d| d / 2).collect();
+        let trailing: Vec<bool> = (0..n1).map(|node| node % nx == 4 || node == 3).collect();
+        let m = 2 * trailing.iter().filter(|&&t| t).count();
+        let mut chol =
+            SparseCholesky::analyze_trailing(n, &col_ptr, &rows, &groups, &trailing, 1).unwrap();
+        chol.factorize(&vals).unwrap();
+        let (dofs, l) = chol.trailing_factor(m).unwrap();
+        assert!(dofs.iter().all(|&d| trailing[d / 2]));
+        // Dense A, then S = A22 − A21 A11⁻¹ A12 by Gaussian elimination of the leading DOFs.
+        let mut a = faer::Mat::<f64>::zeros(n, n);
+        for j in 0..n {
+            for p in col_ptr[j]..col_ptr[j + 1] {
+                a[(rows[p], j)] = vals[p];
+                a[(j, rows[p])] = vals[p];
+            }
+        }
+        let order: Vec<usize> = (0..n)
+            .filter(|d| !dofs.contains(d))
+            .chain(dofs.iter().copied())
+            .collect();
+        let mut b: Vec<Vec<f64>> = order
+            .iter()
+            .map(|&i| order.iter().map(|&j| a[(i, j)]).collect())
+            .collect();
+        for k in 0..n - m {
+            let pivot = b[k].clone();
+            for row in b.iter_mut().skip(k + 1) {
+                let f = row[k] / pivot[k];
+                for (x, p) in row.iter_mut().zip(&pivot).skip(k) {
+                    *x -= f * p;
+                }
+            }
+        }
+        let mut worst: f64 = 0.0;
+        for i in 0..m {
+            for j in 0..m {
+                let llt: f64 = (0..m).map(|k| l[(i, k)] * l[(j, k)]).sum();
+                worst = worst.max((llt - b[n - m + i][n - m + j]).abs());
+            }
+        }
+        assert!(
+            worst < 1e-12,
+            "L22 L22ᵀ differs from the Schur complement by {worst}"
+        );
+        // The upper triangle of the block is zero: it is a factor.
+        assert!((0..m).all(|i| (i + 1..m).all(|j| l[(i, j)] == 0.0)));
     }
 
     #[test]

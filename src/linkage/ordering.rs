@@ -64,6 +64,53 @@ pub fn nested_dissection(
     Ok((perm, inv))
 }
 
+/// [`nested_dissection`] of the vertices not marked `trailing`, followed by the trailing ones
+/// in ascending order: eliminating the others first leaves, in the last block of the
+/// Cholesky factor, the factor of the Schur complement on the trailing vertices (used to
+/// condense a body on its contact candidates). Returns `(perm, inv)` as above.
+pub fn nested_dissection_with_trailing(
+    xadj: &[usize],
+    adjncy: &[usize],
+    trailing: &[bool],
+) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
+    let n = check_csr(xadj, adjncy)?;
+    if trailing.len() != n {
+        return Err(OrderingError::InvalidGraph(format!(
+            "{} trailing marks for {n} vertices",
+            trailing.len()
+        )));
+    }
+    // The subgraph of the leading vertices, renumbered.
+    let mut local = vec![usize::MAX; n];
+    let leading: Vec<usize> = (0..n).filter(|&v| !trailing[v]).collect();
+    for (i, &v) in leading.iter().enumerate() {
+        local[v] = i;
+    }
+    let mut sx = Vec::with_capacity(leading.len() + 1);
+    let mut sa = Vec::new();
+    sx.push(0);
+    for &v in &leading {
+        sa.extend(
+            adjncy[xadj[v]..xadj[v + 1]]
+                .iter()
+                .filter(|&&u| local[u] != usize::MAX)
+                .map(|&u| local[u]),
+        );
+        sx.push(sa.len());
+    }
+    let (sub, _) = nested_dissection(&sx, &sa)?;
+    let perm: Vec<usize> = sub
+        .iter()
+        .map(|&i| leading[i])
+        .chain((0..n).filter(|&v| trailing[v]))
+        .collect();
+    let mut inv = vec![0; n];
+    for (new, &old) in perm.iter().enumerate() {
+        inv[old] = new;
+    }
+    Ok((perm, inv))
+}
+
 /// Node adjacency graph (CSR, symmetric, no self loops, no duplicates) of a symmetric
 /// sparsity pattern stored as CSC (`col_ptr` of length `n + 1`, any triangle or both).
 ///
