@@ -47,6 +47,7 @@ mod member_stiffness;
 mod newton;
 pub mod ordering;
 pub mod paper_files;
+pub mod rigid_modes;
 mod smoothed_aggregation;
 mod solver_choice;
 mod step_state;
