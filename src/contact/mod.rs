@@ -11,6 +11,7 @@ pub use self::settings::ContactSettings;
 pub use self::settle::{ContactSolver, ContactStep};
 
 mod boundary;
+mod condensed;
 mod contact_set;
 mod coupled_system;
 mod error;

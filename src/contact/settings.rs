@@ -13,6 +13,10 @@ pub struct ContactSettings {
     pub tolerance: Option<Real>,
     /// Contact iterations (solve, query, new penalties) allowed per step.
     pub max_iterations: usize,
+    /// When every body is linear: factor each body once per run and solve the contact problem
+    /// on its contact candidates (`true`, the default), rather than factoring the coupled
+    /// system of all bodies at every contact iteration.
+    pub condense: bool,
 }
 
 impl Default for ContactSettings {
@@ -21,6 +25,7 @@ impl Default for ContactSettings {
             penalty: None,
             tolerance: None,
             max_iterations: 50,
+            condense: true,
         }
     }
 }

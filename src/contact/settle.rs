@@ -26,6 +26,9 @@ use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::time::Instant;
 
+mod condensed_newton;
+use condensed_newton::{candidate_nodes, Condensation};
+
 /// The stabilisation of a singular tangent, relative to its largest diagonal entry: small
 /// enough that the stabilised matrix is still the tangent to 9 digits, large enough to factor.
 pub const STABILISATION: Real = 1e-9;
@@ -116,6 +119,9 @@ pub struct ContactSolver {
     unheld: usize,
     /// The contact set the current factorization was made with (not stabilised).
     factored: Option<ContactSet>,
+    /// Every body linear: each factored once per run and condensed on its contact candidates
+    /// (`None`: the coupled solve).
+    condensed: Option<Vec<Condensation>>,
     /// Time spent so far in each phase, s.
     pub times: PhaseTimes,
     /// Time spent so far finding contacts (projecting nodes on obstacles), s.
@@ -159,16 +165,11 @@ impl ContactSolver {
             nodes += body.nodes.len();
         }
         let assembly_time = t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let assemblies: Vec<&StiffnessAssembly> = parts.iter().map(|p| &p.assembly).collect();
-        let system = CoupledSystem::new(&assemblies, &node_offsets, &[])
-            .map_err(|e| ContactError::Factorization(e.to_string()))?;
-        let times = PhaseTimes {
+        let mut times = PhaseTimes {
             assembly: assembly_time,
-            symbolic: t.elapsed().as_secs_f64(),
             ..Default::default()
         };
-        let surfaces = bodies.iter().map(Surface::of).collect();
+        let surfaces: Vec<Option<Surface>> = bodies.iter().map(Surface::of).collect();
         let mut patch_surfaces = Vec::with_capacity(bodies.len());
         for body in bodies {
             // An open shell is not a contact target yet (its nodes still press on the others).
@@ -183,13 +184,49 @@ impl ContactSolver {
                 }
             });
         }
+        let obstacle_set = Obstacles::new(obstacles).map_err(ContactError::Obstacle)?;
+        let mut condensed = None;
+        if settings.condense && bodies.iter().all(|b| !b.is_nonlinear()) {
+            // Obstacle offsets along their travel, sampled (a candidate missed is added later).
+            let travels: Vec<Vec<Vector3<Real>>> = obstacles
+                .iter()
+                .map(|o| (0..=32).map(|s| o.offset(s, 32)).collect())
+                .collect();
+            let marks =
+                candidate_nodes(bodies, &surfaces, &patch_surfaces, &obstacle_set, &travels);
+            let mut built = Vec::with_capacity(bodies.len());
+            for ((body, part), mark) in bodies.iter().zip(&parts).zip(marks) {
+                match Condensation::build(body, &part.dofs, &part.assembly, mark) {
+                    Some(c) => {
+                        times.symbolic += c.seconds[0];
+                        times.numeric += c.seconds[1];
+                        times.solve += c.seconds[2];
+                        built.push(Condensation::new(c, body.dof_count()));
+                    }
+                    None => break,
+                }
+            }
+            if built.len() == bodies.len() {
+                condensed = Some(built);
+            }
+        }
+        let t = Instant::now();
+        let system = if condensed.is_some() {
+            CoupledSystem::new(&[], &[], &[])
+        } else {
+            let assemblies: Vec<&StiffnessAssembly> = parts.iter().map(|p| &p.assembly).collect();
+            CoupledSystem::new(&assemblies, &node_offsets, &[])
+        }
+        .map_err(|e| ContactError::Factorization(e.to_string()))?;
+        times.symbolic += t.elapsed().as_secs_f64();
         Ok(ContactSolver {
             parts,
             node_offsets,
             surfaces,
             patch_surfaces,
             coupling: Vec::new(),
-            obstacles: Obstacles::new(obstacles).map_err(ContactError::Obstacle)?,
+            obstacles: obstacle_set,
+            condensed,
             system,
             settings,
             active: ContactSet::default(),
@@ -205,6 +242,22 @@ impl ContactSolver {
             times,
             query_seconds: 0.0,
         })
+    }
+
+    /// Whether the bodies are solved condensed on their contact candidates (every body linear,
+    /// each factored once per run), rather than as one coupled system.
+    pub fn is_condensed(&self) -> bool {
+        self.condensed.is_some()
+    }
+
+    /// The coupled system of all bodies, analyzed (when leaving the condensed path).
+    fn build_coupled(&mut self) -> Result<(), ContactError> {
+        let t = Instant::now();
+        let assemblies: Vec<&StiffnessAssembly> = self.parts.iter().map(|p| &p.assembly).collect();
+        self.system = CoupledSystem::new(&assemblies, &self.node_offsets, &self.coupling)
+            .map_err(|e| ContactError::Factorization(e.to_string()))?;
+        self.times.symbolic += t.elapsed().as_secs_f64();
+        Ok(())
     }
 
     /// The smallest force scale a residual is measured against, N: `FORCE_FLOOR` times the
@@ -250,13 +303,15 @@ impl ContactSolver {
         step: usize,
         steps: usize,
     ) -> Result<ContactStep, ContactError> {
-        if step == 0 || step < self.step {
+        let restart = step == 0 || step < self.step;
+        if restart {
             for p in &mut self.parts {
                 p.u.iter_mut().for_each(|v| *v = 0.0);
             }
             self.active = ContactSet::default();
             self.normals.clear();
         }
+        self.condensed_step(step, steps, restart);
         self.step = step;
         let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset(step, steps)).collect();
         let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, step, steps)).collect();
@@ -269,14 +324,33 @@ impl ContactSolver {
         let mut set = self.active.clone();
         let mut seen: Vec<ContactSet> = Vec::new();
         let mut out = ContactStep::default();
+        let mut refinements = 0;
         loop {
             out.contact_iterations += 1;
-            let (iterations, settled) = self.newton(bodies, &set, &forces, &offsets, step)?;
+            let (iterations, settled) = if self.condensed.is_some() {
+                self.newton_condensed(bodies, &set, &forces, &offsets, step)?
+            } else {
+                self.newton(bodies, &set, &forces, &offsets, step)?
+            };
             out.newton_iterations += iterations;
             out.stabilised |= !settled;
             let t = Instant::now();
-            let found = self.query(bodies, &offsets);
+            let mut found = self.query(bodies, &offsets);
             self.query_seconds += t.elapsed().as_secs_f64();
+            if settled && found == set && self.condensed.is_some() {
+                // Settled on the candidates: solve for every node, and look again with them.
+                let differs = self.expand_condensed();
+                let t = Instant::now();
+                found = self.query(bodies, &offsets);
+                self.query_seconds += t.elapsed().as_secs_f64();
+                // The placement was off by the compliance's round-off (a penalty turns 1e-13 m
+                // into forces the tolerance sees): Newton again from the solve, which returns
+                // at once when the residual there is within the tolerance.
+                if found == set && differs > 1e-12 && refinements < 3 {
+                    refinements += 1;
+                    continue;
+                }
+            }
             if !settled {
                 // A stabilised move toward the contacts: look again, no equilibrium yet.
                 if out.contact_iterations >= self.settings.max_iterations {
@@ -313,6 +387,7 @@ impl ContactSolver {
             set = found;
         }
         self.active = set;
+        self.expand_condensed();
         self.finish(bodies, &forces, &offsets, step, out)
     }
 

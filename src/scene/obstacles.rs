@@ -175,5 +175,6 @@ pub(crate) fn contact_settings(spec: Option<&ContactSpec>) -> Result<ContactSett
         }
         settings.max_iterations = n;
     }
+    settings.condense = spec.condense.unwrap_or(settings.condense);
     Ok(settings)
 }

@@ -39,6 +39,8 @@ pub struct ContactSpec {
     pub tolerance: Option<Real>,
     /// Contact iterations per step (default 50).
     pub max_iterations: Option<usize>,
+    /// Linear bodies factored once and condensed on their contact candidates (default true).
+    pub condense: Option<bool>,
 }
 
 /// `[[obstacles]]`: a rigid obstacle (see `docs/SCENES.md`).

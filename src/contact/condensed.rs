@@ -1,0 +1,613 @@
+//! Linear bodies in contact, factored once per run and condensed on their contact candidates.
+//!
+//! A body with linear kinematics keeps its stiffness `K` for the whole run. Its contact
+//! candidates (the surface nodes near another body or an obstacle) are ordered last in the
+//! factorization, so the last block of the factor is the Cholesky factor of the Schur
+//! complement `S` on the candidate DOFs; its inverse, the compliance `C = S⁻¹` (m/N), is
+//! formed once per run. A body free to move rigidly (held only by contact) is pinned at one
+//! DOF per free rigid motion, which makes `K` regular and its inverse a generalized inverse;
+//! the rigid motions `R` are then unknowns of the contact problem, with the condition that the
+//! forces on the body balance along them.
+//!
+//! With contact forces `f̂` on the candidates and rigid motions `α`, the displacements of the
+//! candidates are `u_C = u₀ + C f̂ + R_C α`, where `u₀ = K⁻¹ b` for the step's load `b`, summed
+//! from one solve per load schedule. A Newton iteration of the contact problem is then a dense
+//! problem of the size of the active contacts (see [`contact_newton_step`]); the whole
+//! displacement field costs one solve per body per load step ([`CondensedBody::expand`]).
+
+use crate::linkage::cholesky::SparseCholesky;
+use crate::linkage::rigid_modes::{free_rigid_modes, pinned_dofs_avoiding};
+use crate::linkage::{
+    member_block, prescribed_displacements, Body, DofMap, Schedule, StiffnessAssembly,
+};
+use crate::Real;
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
+
+/// A free DOF that is not a contact candidate.
+pub(crate) const NOT_CANDIDATE: usize = usize::MAX;
+
+/// The most candidate DOFs a body may have (its compliance is dense: 8,000 DOFs take 512 MB).
+pub(crate) const MAX_CANDIDATE_DOFS: usize = 8_000;
+
+/// One load schedule of a body: its load at full value and the displacement it gives.
+struct Pattern {
+    schedule: Schedule,
+    /// Applied force minus the pull of the prescribed displacements, per free DOF, N.
+    load: Vec<Real>,
+    /// `K⁻¹ load` at the candidate slots, m.
+    base: Vec<Real>,
+}
+
+/// A linear body factored once, condensed on its contact candidates.
+pub(crate) struct CondensedBody {
+    /// Free index of each candidate slot (the compliance's rows), in factor order.
+    pub cand: Vec<usize>,
+    /// Candidate slot of each free index, or [`NOT_CANDIDATE`].
+    pub slot: Vec<usize>,
+    /// Which nodes are candidates.
+    pub nodes: Vec<bool>,
+    /// `C = S⁻¹` on the candidates, column-major, full, m/N.
+    compliance: Vec<Real>,
+    /// The rigid motions left free by the supports, over free DOFs, each scaled to a largest
+    /// entry of one.
+    pub modes: Vec<Vec<Real>>,
+    /// The same at the candidate slots.
+    pub modes_c: Vec<Vec<Real>>,
+    /// Free indices held to make the stiffness regular (one per rigid motion).
+    pins: Vec<usize>,
+    /// The rigid motions, orthonormal (the projection `P = I − Q Qᵀ` of inertia relief).
+    basis: Vec<Vec<Real>>,
+    cholesky: SparseCholesky,
+    patterns: Vec<Pattern>,
+    /// Time of ordering and symbolic analysis, of the factorization and compliance, and of the
+    /// pattern solves, s.
+    pub seconds: [Real; 3],
+}
+
+impl CondensedBody {
+    /// Factor `body` with the nodes marked in `nodes` last, form the compliance on them and
+    /// solve each load schedule once. `Err` with the reason when the body cannot be condensed
+    /// (a mechanism beyond rigid motions, too many candidates): the caller then solves the
+    /// coupled system instead.
+    pub fn new(
+        body: &Body,
+        dofs: &DofMap,
+        assembly: &StiffnessAssembly,
+        nodes: Vec<bool>,
+    ) -> Result<Self, String> {
+        let t = std::time::Instant::now();
+        let n = assembly.n;
+        let d = dofs.dofs_per_node;
+        let mut slot = vec![NOT_CANDIDATE; n];
+        let m = assembly.groups.iter().filter(|&&g| nodes[g]).count();
+        if m > MAX_CANDIDATE_DOFS {
+            return Err(format!("{m} candidate DOFs (at most {MAX_CANDIDATE_DOFS})"));
+        }
+        // Each rigid motion scaled to move the farthest DOF by one: its amplitude is a length
+        // and its stiffness `Bᵀ A⁻¹ B` compares with the penalties.
+        let basis = free_rigid_modes(body, dofs);
+        let mut modes = basis.clone();
+        for r in &mut modes {
+            let largest = r.iter().fold(0.0, |a: Real, v| a.max(v.abs()));
+            if largest > 0.0 {
+                r.iter_mut().for_each(|v| *v /= largest);
+            }
+        }
+        // Pins as far from the candidates as the body allows (over its member graph): the
+        // pinned solution of an unbalanced load bends the body around the pin.
+        let far = far_from(body, &nodes);
+        let avoid: Vec<bool> = assembly.groups.iter().map(|&g| !far[g]).collect();
+        let pins = pinned_dofs_avoiding(&modes, &avoid);
+        if pins.len() != modes.len() {
+            return Err("the rigid motions cannot be pinned".into());
+        }
+        let mut cholesky = SparseCholesky::analyze_trailing(
+            n,
+            &assembly.col_ptr,
+            &assembly.row_idx,
+            &assembly.groups,
+            &nodes,
+            0,
+        )
+        .map_err(|e| e.to_string())?;
+        let symbolic = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let mut values = Vec::new();
+        assembly.fill(body, |k| linear_block(body, k), &mut values);
+        let mut pinned = vec![false; n];
+        for &p in &pins {
+            pinned[p] = true;
+        }
+        for c in 0..n {
+            let range = assembly.col_ptr[c]..assembly.col_ptr[c + 1];
+            for (&r, v) in assembly.row_idx[range.clone()]
+                .iter()
+                .zip(&mut values[range])
+            {
+                if r != c && (pinned[r] || pinned[c]) {
+                    *v = 0.0;
+                }
+            }
+        }
+        cholesky.factorize(&values).map_err(|e| e.to_string())?;
+        let (order, factor) = cholesky
+            .trailing_factor(m)
+            .ok_or("the factor has no trailing block")?;
+        for (s, &i) in order.iter().enumerate() {
+            if !nodes[assembly.groups[i]] {
+                return Err("the candidates are not last in the factor".into());
+            }
+            slot[i] = s;
+        }
+        let mut compliance = inverse_from_factor(&factor);
+        // A pinned DOF does not move: its row and column (only its own diagonal, as pinning
+        // cut its couplings) are zero in the generalized inverse.
+        for &p in &pins {
+            let s = slot[p];
+            if s != NOT_CANDIDATE {
+                for j in 0..m {
+                    compliance[s * m + j] = 0.0;
+                    compliance[j * m + s] = 0.0;
+                }
+            }
+        }
+        let modes_c = modes
+            .iter()
+            .map(|r| order.iter().map(|&i| r[i]).collect())
+            .collect();
+        let numeric = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        // Inertia relief: with P = I − Q Qᵀ (Q the orthonormal rigid motions) the compliance is
+        // Pᵀ K⁻¹ P on the candidates, C − Z_C Q_Cᵀ − Q_C Z_Cᵀ + Q_C (Qᵀ Z) Q_Cᵀ with Z = K⁻¹ Q:
+        // an unbalanced load is balanced by a body force spread over every DOF instead of
+        // being carried by the pins.
+        let mut z = Vec::with_capacity(basis.len());
+        for q in &basis {
+            let mut x = q.clone();
+            for &p in &pins {
+                x[p] = 0.0;
+            }
+            cholesky.solve_in_place(&mut x);
+            z.push(x);
+        }
+        let at = |v: &Vec<Real>| -> Vec<Real> { order.iter().map(|&i| v[i]).collect() };
+        let zc: Vec<Vec<Real>> = z.iter().map(at).collect();
+        let qc: Vec<Vec<Real>> = basis.iter().map(at).collect();
+        for a in 0..basis.len() {
+            for b in 0..basis.len() {
+                let h: Real = basis[a].iter().zip(&z[b]).map(|(x, y)| x * y).sum();
+                let (za, qa, zb, qb) = (&zc[a], &qc[a], &zc[b], &qc[b]);
+                for j in 0..m {
+                    let column = &mut compliance[j * m..(j + 1) * m];
+                    for (i, c) in column.iter_mut().enumerate() {
+                        *c += -za[i] * qb[j] - qa[i] * zb[j] + qa[i] * h * qb[j];
+                    }
+                }
+            }
+        }
+        let relief = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let mut condensed = CondensedBody {
+            cand: order,
+            slot,
+            nodes,
+            compliance,
+            modes,
+            modes_c,
+            pins,
+            basis,
+            cholesky,
+            patterns: Vec::new(),
+            seconds: [symbolic, numeric + relief, 0.0],
+        };
+        // One solve per schedule of loads and prescribed displacements.
+        let mut schedules: Vec<Schedule> = Vec::new();
+        let prescribed = body
+            .supports
+            .iter()
+            .filter(|s| s.displacement != nalgebra::Vector3::zeros());
+        for s in body
+            .loads
+            .iter()
+            .map(|l| &l.schedule)
+            .chain(prescribed.map(|s| &s.schedule))
+        {
+            if !schedules.contains(s) {
+                schedules.push(s.clone());
+            }
+        }
+        for schedule in schedules {
+            let mut full = vec![0.0; body.dof_count()];
+            for l in body.loads.iter().filter(|l| l.schedule == schedule) {
+                for k in 0..d {
+                    full[l.node * d + k] += l.force[k];
+                }
+            }
+            let u_s = prescribed_displacements(body, |s| Real::from(u8::from(*s == schedule)));
+            let pull = linear_internal_forces(body, d, &u_s);
+            let load: Vec<Real> = dofs.free.iter().map(|&f| full[f] - pull[f]).collect();
+            let x = condensed.solve(&load);
+            let base = condensed.cand.iter().map(|&i| x[i]).collect();
+            condensed.patterns.push(Pattern {
+                schedule,
+                load,
+                base,
+            });
+        }
+        condensed.seconds[2] = t.elapsed().as_secs_f64();
+        Ok(condensed)
+    }
+
+    /// Number of candidate DOFs.
+    pub fn len(&self) -> usize {
+        self.cand.len()
+    }
+
+    /// The load of `step` of `steps` per free DOF (N) and `K⁻¹` of it at the candidates (m).
+    pub fn step_load(&self, step: usize, steps: usize) -> (Vec<Real>, Vec<Real>) {
+        let mut load = vec![0.0; self.slot.len()];
+        let mut base = vec![0.0; self.cand.len()];
+        for p in &self.patterns {
+            let f = p.schedule.factor(step, steps);
+            load.iter_mut().zip(&p.load).for_each(|(a, b)| *a += f * b);
+            base.iter_mut().zip(&p.base).for_each(|(a, b)| *a += f * b);
+        }
+        (load, base)
+    }
+
+    /// `Pᵀ K⁻¹ P rhs` per free DOF, with `K⁻¹` the inverse with the pins held and
+    /// `P = I − Q Qᵀ`: the displacement under the balanced part of `rhs`, without rigid motion.
+    fn solve(&mut self, rhs: &[Real]) -> Vec<Real> {
+        let mut x = rhs.to_vec();
+        self.project(&mut x);
+        for &p in &self.pins {
+            x[p] = 0.0;
+        }
+        self.cholesky.solve_in_place(&mut x);
+        self.project(&mut x);
+        x
+    }
+
+    /// `x ← (I − Q Qᵀ) x`.
+    fn project(&self, x: &mut [Real]) {
+        for q in &self.basis {
+            let p: Real = q.iter().zip(x.iter()).map(|(a, b)| a * b).sum();
+            x.iter_mut().zip(q).for_each(|(v, a)| *v -= p * a);
+        }
+    }
+
+    /// `C f` at the candidate slots, m, for contact forces `f` (N) at the slots (mostly zero).
+    pub fn comply(&self, f: &[Real]) -> Vec<Real> {
+        let m = self.cand.len();
+        let mut y = vec![0.0; m];
+        for (j, &fj) in f.iter().enumerate() {
+            if fj != 0.0 {
+                let column = &self.compliance[j * m..(j + 1) * m];
+                y.iter_mut().zip(column).for_each(|(a, c)| *a += fj * c);
+            }
+        }
+        y
+    }
+
+    /// Column `j` of the compliance.
+    pub fn compliance_column(&self, j: usize) -> &[Real] {
+        let m = self.cand.len();
+        &self.compliance[j * m..(j + 1) * m]
+    }
+
+    /// The change of displacement of every free DOF, m, for a change `rhs` of the load and
+    /// contact forces per free DOF (N) and `alpha` of the rigid amplitudes: `K⁻¹ rhs + R α`
+    /// (one solve). Solving for changes keeps the solve's round-off relative to the change,
+    /// as Newton's corrections do, not to the whole displacement.
+    pub fn expand(&mut self, rhs: &[Real], alpha: &[Real]) -> Vec<Real> {
+        let mut x = self.solve(rhs);
+        for (r, &a) in self.modes.iter().zip(alpha) {
+            x.iter_mut().zip(r).for_each(|(u, m)| *u += a * m);
+        }
+        x
+    }
+}
+
+/// The nodes at least three quarters of the largest member-graph distance away from the
+/// marked nodes (all nodes when none is marked).
+fn far_from(body: &Body, marked: &[bool]) -> Vec<bool> {
+    let n = body.nodes.len();
+    let mut adjacency: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for member in &body.members {
+        let [a, b] = member.nodes;
+        adjacency[a].push(b);
+        adjacency[b].push(a);
+    }
+    let mut distance = vec![usize::MAX; n];
+    let mut queue: std::collections::VecDeque<usize> = (0..n).filter(|&i| marked[i]).collect();
+    if queue.is_empty() {
+        return vec![true; n];
+    }
+    for &i in &queue {
+        distance[i] = 0;
+    }
+    while let Some(i) = queue.pop_front() {
+        for &j in &adjacency[i] {
+            if distance[j] == usize::MAX {
+                distance[j] = distance[i] + 1;
+                queue.push_back(j);
+            }
+        }
+    }
+    let largest = distance
+        .iter()
+        .filter(|&&d| d != usize::MAX)
+        .max()
+        .copied()
+        .unwrap_or(0);
+    distance
+        .iter()
+        .map(|&d| d != usize::MAX && 4 * d >= 3 * largest)
+        .collect()
+}
+
+/// The linear stiffness block `(E A / L) n nᵀ` of member `m`, N/m (paper Eq. 1–2).
+fn linear_block(body: &Body, m: usize) -> nalgebra::Matrix3<Real> {
+    let member = body.members[m];
+    let [a, b] = member.nodes;
+    let material = &body.materials[member.material];
+    member_block(
+        &body.nodes[a],
+        &body.nodes[b],
+        material.youngs_modulus * material.area / body.member_length(m),
+    )
+}
+
+/// `K u` per body DOF for the linear stiffness, N.
+fn linear_internal_forces(body: &Body, d: usize, u: &[Real]) -> Vec<Real> {
+    let mut out = vec![0.0; body.dof_count()];
+    for (m, member) in body.members.iter().enumerate() {
+        let [a, b] = member.nodes;
+        let k = linear_block(body, m);
+        let mut du = nalgebra::Vector3::zeros();
+        for i in 0..d {
+            du[i] = u[b * d + i] - u[a * d + i];
+        }
+        let f = k * du;
+        for i in 0..d {
+            out[a * d + i] -= f[i];
+            out[b * d + i] += f[i];
+        }
+    }
+    out
+}
+
+/// `(L Lᵀ)⁻¹` for a dense lower-triangular `L`, full and column-major.
+fn inverse_from_factor(l: &Mat<Real>) -> Vec<Real> {
+    let m = l.nrows();
+    if m == 0 {
+        return Vec::new();
+    }
+    let par = faer::Par::rayon(0);
+    let mut out = Mat::<Real>::zeros(m, m);
+    let mut mem =
+        faer::dyn_stack::MemBuffer::new(faer::linalg::cholesky::llt::inverse::inverse_scratch::<
+            Real,
+        >(m, par));
+    faer::linalg::cholesky::llt::inverse::inverse(
+        out.as_mut(),
+        l.as_ref(),
+        par,
+        faer::dyn_stack::MemStack::new(&mut mem),
+    );
+    let mut full = vec![0.0; m * m];
+    for j in 0..m {
+        for i in j..m {
+            let v = out[(i, j)];
+            full[j * m + i] = v;
+            full[i * m + j] = v;
+        }
+    }
+    full
+}
+
+/// One active contact of the condensed problem: its penalty (N/m) and its row of `G`, the
+/// change of penetration per unit displacement, as (body, candidate slot, coefficient).
+pub(crate) struct ContactRow {
+    pub penalty: Real,
+    pub entries: Vec<(usize, usize, Real)>,
+}
+
+/// A Newton correction of the condensed contact problem.
+pub(crate) struct Correction {
+    /// Change of the contact forces at each body's candidate slots, N.
+    pub fhat: Vec<Vec<Real>>,
+    /// Change of each body's rigid-motion amplitudes, m.
+    pub alpha: Vec<Vec<Real>>,
+    /// Whether a rigid motion had nothing holding it (moved by the stabilisation).
+    pub stabilised: bool,
+}
+
+/// The factored Jacobian of the condensed contact problem for a list of contact rows:
+///
+/// `δf̂ = Φ₁ − Gᵀμ`, `(κ⁻¹ + G C Gᵀ) μ = G C Φ₁ + B δα`, `Bᵀ μ = R_Cᵀ Φ₁ + Φ₂`, `B = G R_C`,
+///
+/// for residuals `Φ₁` (contact force found minus assumed at each body's candidates, N) and
+/// `Φ₂` (out-of-balance of each body along its rigid motions, N): a dense problem of the size
+/// of the active contacts, factored once and reused while Newton converges with it (a modified
+/// Newton step when the contacts' normals and weights have moved a little). Rigid motions the
+/// contacts do not hold (an eigenvalue of `Bᵀ A⁻¹ B` below 1000 `stabilisation`, N/m) are moved
+/// by their out-of-balance over `stabilisation`, as the coupled solve does.
+pub(crate) struct ContactJacobian {
+    rows: Vec<ContactRow>,
+    llt: faer::linalg::solvers::Llt<Real>,
+    /// `[B | A⁻¹ B]`, k × 2r.
+    b_psi: Mat<Real>,
+    /// First rigid amplitude of each body in the global list.
+    first: Vec<usize>,
+    /// Eigenvalues and eigenvectors of `Bᵀ A⁻¹ B` (none without rigid motions).
+    eigen: Option<nalgebra::SymmetricEigen<Real, nalgebra::Dyn>>,
+    stabilisation: Real,
+}
+
+impl ContactJacobian {
+    /// Form and factor the Jacobian for `rows`.
+    pub(crate) fn new(
+        bodies: &[&CondensedBody],
+        rows: Vec<ContactRow>,
+        stabilisation: Real,
+    ) -> Result<Self, String> {
+        let k = rows.len();
+        // W_b = C_b G_bᵀ, one column per contact (zero where the contact does not touch b).
+        let mut w: Vec<Option<Mat<Real>>> = bodies.iter().map(|_| None).collect();
+        for (e, row) in rows.iter().enumerate() {
+            for &(b, s, v) in &row.entries {
+                let c = bodies[b].compliance_column(s);
+                let wb = w[b].get_or_insert_with(|| Mat::zeros(bodies[b].len(), k));
+                let mut col = wb.col_mut(e);
+                for (i, &ci) in c.iter().enumerate() {
+                    col[i] += v * ci;
+                }
+            }
+        }
+        // A = κ⁻¹ + G W, column by column (W's columns are contiguous).
+        let mut a = Mat::<Real>::zeros(k, k);
+        for e2 in 0..k {
+            let columns: Vec<Option<&[Real]>> = w
+                .iter()
+                .map(|wb| {
+                    wb.as_ref()
+                        .and_then(|m| m.col(e2).try_as_col_major().map(|c| c.as_slice()))
+                })
+                .collect();
+            let mut col = a.col_mut(e2);
+            for (e1, row) in rows.iter().enumerate() {
+                let mut sum = 0.0;
+                for &(b, s, v) in &row.entries {
+                    if let Some(c) = columns[b] {
+                        sum += v * c[s];
+                    }
+                }
+                col[e1] += sum;
+            }
+            col[e2] += 1.0 / rows[e2].penalty;
+        }
+        drop(w);
+        // Symmetrize round-off before the factorization.
+        for i in 0..k {
+            for j in 0..i {
+                let v = 0.5 * (a[(i, j)] + a[(j, i)]);
+                a[(i, j)] = v;
+                a[(j, i)] = v;
+            }
+        }
+        let llt = a
+            .llt(Side::Lower)
+            .map_err(|e| format!("the contact matrix is not positive definite: {e:?}"))?;
+        let mut first = Vec::with_capacity(bodies.len());
+        let mut r = 0;
+        for b in bodies {
+            first.push(r);
+            r += b.modes.len();
+        }
+        // B = G R_C, then A⁻¹ B beside it.
+        let mut b_psi = Mat::<Real>::zeros(k, 2 * r);
+        for (e, row) in rows.iter().enumerate() {
+            for &(b, s, v) in &row.entries {
+                for (j, mode) in bodies[b].modes_c.iter().enumerate() {
+                    b_psi[(e, first[b] + j)] += v * mode[s];
+                    b_psi[(e, r + first[b] + j)] += v * mode[s];
+                }
+            }
+        }
+        llt.solve_in_place(b_psi.subcols_mut(r, r));
+        let mut m = nalgebra::DMatrix::<Real>::zeros(r, r);
+        for i in 0..r {
+            for j in 0..r {
+                m[(i, j)] = (0..k).map(|e| b_psi[(e, i)] * b_psi[(e, r + j)]).sum();
+            }
+        }
+        let m = (&m + m.transpose()) * 0.5;
+        Ok(ContactJacobian {
+            rows,
+            llt,
+            b_psi,
+            first,
+            eigen: (r > 0).then(|| m.symmetric_eigen()),
+            stabilisation,
+        })
+    }
+
+    /// The contact rows the Jacobian was formed with.
+    pub(crate) fn rows(&self) -> &[ContactRow] {
+        &self.rows
+    }
+
+    /// The Newton correction for residuals `phi1` and `phi2` (see the type).
+    pub(crate) fn correction(
+        &self,
+        bodies: &[&CondensedBody],
+        phi1: &[Vec<Real>],
+        phi2: &[Vec<Real>],
+    ) -> Correction {
+        let k = self.rows.len();
+        let r = self.eigen.as_ref().map_or(0, |e| e.eigenvalues.len());
+        let cphi: Vec<Vec<Real>> = bodies.iter().zip(phi1).map(|(b, p)| b.comply(p)).collect();
+        // μ₀ = A⁻¹ G C Φ₁.
+        let mut mu = Mat::<Real>::zeros(k, 1);
+        for (e, row) in self.rows.iter().enumerate() {
+            mu[(e, 0)] = row.entries.iter().map(|&(b, s, v)| v * cphi[b][s]).sum();
+        }
+        self.llt.solve_in_place(mu.as_mut());
+        let mut dalpha = vec![0.0; r];
+        let mut stabilised = false;
+        if let Some(eigen) = &self.eigen {
+            let mut g = nalgebra::DVector::<Real>::zeros(r);
+            for (b, body) in bodies.iter().enumerate() {
+                for (j, mode) in body.modes_c.iter().enumerate() {
+                    g[self.first[b] + j] =
+                        phi2[b][j] + mode.iter().zip(&phi1[b]).map(|(a, p)| a * p).sum::<Real>();
+                }
+            }
+            for i in 0..r {
+                g[i] -= (0..k)
+                    .map(|e| self.b_psi[(e, i)] * mu[(e, 0)])
+                    .sum::<Real>();
+            }
+            let mut x = nalgebra::DVector::<Real>::zeros(r);
+            for (i, &lambda) in eigen.eigenvalues.iter().enumerate() {
+                let v = eigen.eigenvectors.column(i);
+                let p = v.dot(&g);
+                // Held: a Newton step. Not held (no contact restrains it): a stabilised move.
+                let held = lambda > 1e3 * self.stabilisation;
+                if !held && p != 0.0 {
+                    stabilised = true;
+                }
+                let stiffness = if held {
+                    lambda
+                } else {
+                    lambda.max(0.0) + self.stabilisation
+                };
+                x += v * (p / stiffness);
+            }
+            dalpha.copy_from_slice(x.as_slice());
+        }
+        // μ = μ₀ + Ψ δα; δf̂ = Φ₁ − Gᵀ μ.
+        let mut fhat: Vec<Vec<Real>> = phi1.to_vec();
+        for (e, row) in self.rows.iter().enumerate() {
+            let m = mu[(e, 0)]
+                + (0..r)
+                    .map(|j| self.b_psi[(e, r + j)] * dalpha[j])
+                    .sum::<Real>();
+            for &(b, s, v) in &row.entries {
+                fhat[b][s] -= v * m;
+            }
+        }
+        let alpha = bodies
+            .iter()
+            .enumerate()
+            .map(|(b, body)| dalpha[self.first[b]..self.first[b] + body.modes.len()].to_vec())
+            .collect();
+        Correction {
+            fhat,
+            alpha,
+            stabilised,
+        }
+    }
+}
