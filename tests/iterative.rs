@@ -111,7 +111,9 @@ fn lattices_agree_with_the_direct_solver() {
 
 /// A multi-step large-displacement run: warm starts (each Newton correction solved as the new
 /// displacement from the previous iterate, each solve started from the best combination of
-/// recent solutions) save at least 40% of the conjugate-gradient iterations of cold starts.
+/// recent solutions under the current tangent) save at least half of the conjugate-gradient
+/// iterations of cold starts (each solve from zero to 1e-10 of its own right-hand side), with
+/// the same Newton path for both.
 #[test]
 fn warm_starts_reduce_iterations_over_a_run() {
     let run = |warm: bool| {
@@ -135,14 +137,19 @@ fn warm_starts_reduce_iterations_over_a_run() {
     };
     let (warm, a) = run(true);
     let (cold, b) = run(false);
+    eprintln!("conjugate-gradient iterations over the run: warm {warm}, cold {cold}");
     let scale = b.iter().map(|u| u.norm()).fold(0.0, f64::max);
     for (x, y) in a.iter().zip(&b) {
         assert!((x - y).norm() <= 1e-7 * scale);
     }
-    // Measured 198 against 370 (8×8×20 cells, 6 steps).
+    // Measured 91 against 230 (8×8×20 cells, 6 steps): 60 % fewer. Cold takes 15 or 16
+    // iterations a solve, and Newton makes 2 solves a step once the path can be extrapolated
+    // (4 and 3 in the first two steps); warm needs a handful a solve from the third step on.
+    assert!((200..=260).contains(&cold), "cold {cold} iterations");
+    assert!(warm <= 105, "warm {warm} iterations");
     assert!(
-        10 * warm <= 6 * cold,
-        "warm {warm} vs cold {cold} iterations"
+        2 * warm <= cold,
+        "warm {warm} vs cold {cold} iterations: less than half saved"
     );
 }
 

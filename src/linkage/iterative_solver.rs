@@ -25,9 +25,9 @@ pub(crate) struct IterativeSolver {
     fresh_iterations: Option<usize>,
     /// Whether the values changed since the hierarchy was built.
     stale: bool,
-    /// Recent (solution, right-hand side) pairs, newest last: the warm start is the best
-    /// combination of these solutions for the new right-hand side.
-    history: std::collections::VecDeque<(Vec<Real>, Vec<Real>)>,
+    /// Recent solutions, newest last: the warm start is their best combination for the new
+    /// right-hand side under the current matrix.
+    history: std::collections::VecDeque<Vec<Real>>,
     /// Conjugate-gradient iterations, all solves.
     pub iterations: usize,
 }
@@ -123,7 +123,7 @@ impl IterativeSolver {
             if self.history.len() == WARM_START_VECTORS {
                 self.history.pop_front();
             }
-            self.history.push_back((x.to_vec(), b.to_vec()));
+            self.history.push_back(x.to_vec());
         }
         Ok(report)
     }
@@ -142,21 +142,31 @@ impl IterativeSolver {
         report
     }
 
-    /// The Galerkin combination of recent solutions: x = V c with (Vᵀ K V) c = Vᵀ b. Since a
-    /// converged x_i satisfies K x_i = b_i to the tolerance, K V is the stored right-hand sides,
-    /// so this costs no product with K. It contains the last step's answer scaled to the new
-    /// load and the last Newton correction; the solver starts from zero if it is worse.
+    /// The Galerkin combination of recent solutions: x = V c with (Vᵀ K V) c = Vᵀ b, K the
+    /// current matrix (one product per stored solution: the matrix has changed since they
+    /// were solved, and a projection with the old one can start worse than zero). This is the
+    /// best start in span V in the energy norm; V holds the last step's answers and the last
+    /// Newton corrections, so the new answer scaled from the old is in it. The solver starts
+    /// from zero if the combination is worse.
     fn warm_start(&self, b: &[Real], x: &mut [Real]) {
         let k = self.history.len();
         if !self.settings.warm_start || k == 0 || x.iter().any(|v| *v != 0.0) {
             return;
         }
-        // Symmetrised Vᵀ K V (the stored b_i = K x_i only to the tolerance).
+        let products: Vec<Vec<Real>> = self
+            .history
+            .iter()
+            .map(|v| {
+                let mut y = vec![0.0; v.len()];
+                self.matrix.multiply(v, &mut y);
+                y
+            })
+            .collect();
+        // Vᵀ K V, symmetrised against round-off.
         let g = nalgebra::DMatrix::from_fn(k, k, |i, j| {
-            0.5 * (dot(&self.history[i].0, &self.history[j].1)
-                + dot(&self.history[j].0, &self.history[i].1))
+            0.5 * (dot(&self.history[i], &products[j]) + dot(&self.history[j], &products[i]))
         });
-        let rhs = nalgebra::DVector::from_fn(k, |i, _| dot(&self.history[i].0, b));
+        let rhs = nalgebra::DVector::from_fn(k, |i, _| dot(&self.history[i], b));
         let eigen = g.symmetric_eigen();
         let largest = eigen.eigenvalues.iter().copied().fold(0.0, Real::max);
         if largest.is_nan() || largest <= 0.0 {
@@ -170,7 +180,7 @@ impl IterativeSolver {
                 c += q * (q.dot(&rhs) / lambda);
             }
         }
-        for (i, (v, _)) in self.history.iter().enumerate() {
+        for (i, v) in self.history.iter().enumerate() {
             let ci = c[i];
             if ci != 0.0 && ci.is_finite() {
                 x.iter_mut().zip(v).for_each(|(xi, vi)| *xi += ci * vi);

@@ -4,6 +4,8 @@
 //!
 //! At every iteration the tangent stiffness is refilled in the pattern computed once
 //! ([`StiffnessAssembly::fill`]) and refactored on the symbolic factorization computed once.
+//! Under load control each increment starts from the path extrapolated through the last
+//! converged states when that is closer to equilibrium, which saves the predictor's solve.
 
 use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::step_state::{force_scale, post_process};
@@ -21,6 +23,8 @@ use std::time::Instant;
 struct IncrementFailure {
     reason: String,
     history: Vec<Real>,
+    /// Tangent solves made (one fewer than residuals when it started from an extrapolation).
+    solves: usize,
 }
 
 /// The nonlinear equilibrium of one body, advanced step by step. Holds the current
@@ -58,7 +62,8 @@ pub struct NewtonEquilibrium {
     /// Entries of the factor of the tangent.
     pub factor_entries: usize,
     /// Relative residual after each Newton iteration of the last increment solved (the
-    /// quadratic convergence shows here).
+    /// quadratic convergence shows here); when the increment started from the extrapolated
+    /// path, the first entry is the residual there, before any correction.
     pub residual_history: Vec<Real>,
     solver: Option<TangentSolver>,
     values: Vec<Real>,
@@ -77,7 +82,14 @@ pub struct NewtonEquilibrium {
     /// zero (where both vanish) still converges.
     force_floor: Real,
     displacement_floor: Real,
+    /// The last converged states of the load path (pseudo-time, displacement per body DOF),
+    /// newest last, at most [`PATH_POINTS`]: the next increment starts from their
+    /// extrapolation.
+    path: Vec<(Real, Vec<Real>)>,
 }
+
+/// Converged states kept for the extrapolation (three: up to a quadratic through them).
+const PATH_POINTS: usize = 3;
 
 impl NewtonEquilibrium {
     /// Validate `body`, build its pattern, analyze it once and check that the undeformed
@@ -103,6 +115,7 @@ impl NewtonEquilibrium {
             negative_pivots: 0,
             force_floor: 0.0,
             displacement_floor: 0.0,
+            path: vec![(0.0, vec![0.0; nd])],
         };
         eq.fill_tangent(body);
         eq.times.assembly += t.elapsed().as_secs_f64();
@@ -179,6 +192,8 @@ impl NewtonEquilibrium {
             self.negative_pivots = 0;
             self.force_floor = 0.0;
             self.displacement_floor = 0.0;
+            // Step 0 (no load, no support moved) is in equilibrium undeformed.
+            self.path = vec![(0.0, self.u.clone())];
         }
         let mut iterations = 0;
         let mut cuts = 0;
@@ -375,9 +390,13 @@ impl NewtonEquilibrium {
                     iterations += n;
                     t = t1;
                     size.succeeded();
+                    if self.path.len() == PATH_POINTS {
+                        self.path.remove(0);
+                    }
+                    self.path.push((t1, self.u.clone()));
                 }
                 Err(failure) => {
-                    iterations += failure.history.len();
+                    iterations += failure.solves;
                     self.u = saved;
                     if !size.failed(body.newton.max_cuts) {
                         return Err(not_converged(body, target, &size, failure));
@@ -388,9 +407,10 @@ impl NewtonEquilibrium {
         Ok((iterations, size.cuts))
     }
 
-    /// One load-control increment from the current state to pseudo-time `t1`: a tangent
-    /// predictor (which also moves the prescribed supports), then Newton corrections with a
-    /// line search. Returns the Newton iterations.
+    /// One load-control increment from the current state to pseudo-time `t1`: the path
+    /// extrapolated from the last converged states, or else a tangent predictor (either also
+    /// moves the prescribed supports), then Newton corrections with a line search. Returns the
+    /// Newton iterations (tangent solves).
     fn increment(
         &mut self,
         body: &Body,
@@ -405,36 +425,23 @@ impl NewtonEquilibrium {
             s.set_reference(norm(&forces));
         }
         let mut history = Vec::new();
+        let mut internal = vec![0.0; nd];
+        // Start from the path extrapolated through the last converged states when that is
+        // closer to equilibrium; otherwise take a tangent predictor from the current state.
+        let extrapolated = self.extrapolate(body, t1, &forces, &prescribed, &mut internal);
         let fail = |reason: String, history: &Vec<Real>| IncrementFailure {
             reason,
             history: history.clone(),
+            solves: history.len().saturating_sub(usize::from(extrapolated)),
         };
-        // Predictor: K_ff Δu_f = F_f − f_int,f − K_fs Δu_s.
-        let mut internal = vec![0.0; nd];
-        let mut rhs = self.out_of_balance(body, &forces, &mut internal);
-        self.refactor(body).map_err(|r| fail(r, &history))?;
-        let mut du_s = vec![0.0; nd];
-        let mut moved = false;
-        for &dof in &self.dofs.supported {
-            du_s[dof] = prescribed[dof] - self.u[dof];
-            moved |= du_s[dof] != 0.0;
-        }
-        if moved {
-            let mut k_du = vec![0.0; nd];
-            tangent_times(body, self.dofs.dofs_per_node, &self.u, &du_s, &mut k_du);
-            for (i, &dof) in self.dofs.free.iter().enumerate() {
-                rhs[i] -= k_du[dof];
-            }
-        }
-        self.solve(&mut rhs).map_err(|r| fail(r, &history))?;
-        for &dof in &self.dofs.supported {
-            self.u[dof] = prescribed[dof];
-        }
-        for (i, &dof) in self.dofs.free.iter().enumerate() {
-            self.u[dof] += rhs[i];
-        }
-        let mut last_step = norm(&rhs);
-        let mut iterations = 1;
+        let (mut last_step, mut iterations) = if extrapolated {
+            (Real::INFINITY, 0)
+        } else {
+            let last_step = self
+                .tangent_predictor(body, &forces, &prescribed, &mut internal)
+                .map_err(|r| fail(r, &history))?;
+            (last_step, 1)
+        };
         loop {
             let r = self.out_of_balance(body, &forces, &mut internal);
             let scale = force_scale(&self.dofs, &forces, &internal).max(self.force_floor);
@@ -482,6 +489,98 @@ impl NewtonEquilibrium {
             self.solve(&mut delta).map_err(|r| fail(r, &history))?;
             last_step = self.line_search(body, &forces, &delta, rnorm, &mut internal);
             iterations += 1;
+        }
+    }
+
+    /// The tangent predictor from the current state: `K_ff Δu_f = F_f − f_int,f − K_fs Δu_s`,
+    /// which also moves the prescribed supports to `prescribed`. Returns the length moved.
+    fn tangent_predictor(
+        &mut self,
+        body: &Body,
+        forces: &[Real],
+        prescribed: &[Real],
+        internal: &mut [Real],
+    ) -> Result<Real, String> {
+        let nd = body.dof_count();
+        let mut rhs = self.out_of_balance(body, forces, internal);
+        self.refactor(body)?;
+        let mut du_s = vec![0.0; nd];
+        let mut moved = false;
+        for &dof in &self.dofs.supported {
+            du_s[dof] = prescribed[dof] - self.u[dof];
+            moved |= du_s[dof] != 0.0;
+        }
+        if moved {
+            let mut k_du = vec![0.0; nd];
+            tangent_times(body, self.dofs.dofs_per_node, &self.u, &du_s, &mut k_du);
+            for (i, &dof) in self.dofs.free.iter().enumerate() {
+                rhs[i] -= k_du[dof];
+            }
+        }
+        self.solve(&mut rhs)?;
+        for &dof in &self.dofs.supported {
+            self.u[dof] = prescribed[dof];
+        }
+        for (i, &dof) in self.dofs.free.iter().enumerate() {
+            self.u[dof] += rhs[i];
+        }
+        Ok(norm(&rhs))
+    }
+
+    /// Move to the extrapolation at pseudo-time `t1` of the converged path (a secant through
+    /// the last two states, or a quadratic through the last three), supports at `prescribed`,
+    /// when it leaves a smaller out-of-balance than the current state with the supports moved.
+    /// Returns whether it moved; Newton iterates from there, so the answer is the same, only
+    /// reached from closer (on a smooth path the first out-of-balance is orders smaller than
+    /// the load increment, and a tangent solve is saved).
+    fn extrapolate(
+        &mut self,
+        body: &Body,
+        t1: Real,
+        forces: &[Real],
+        prescribed: &[Real],
+        internal: &mut [Real],
+    ) -> bool {
+        let n = self.path.len();
+        // Only from the newest converged state, which the increment starts from.
+        if n < 2 || self.path[n - 1].1 != self.u {
+            return false;
+        }
+        let current = self.u.clone();
+        for &dof in &self.dofs.supported {
+            self.u[dof] = prescribed[dof];
+        }
+        let mut best = norm(&self.out_of_balance(body, forces, internal));
+        let mut chosen = None;
+        for points in 2..=n {
+            let tail = &self.path[n - points..];
+            // Lagrange weights of the points at t1.
+            let weights: Vec<Real> = (0..points)
+                .map(|j| {
+                    (0..points)
+                        .filter(|&m| m != j)
+                        .map(|m| (t1 - tail[m].0) / (tail[j].0 - tail[m].0))
+                        .product()
+                })
+                .collect();
+            for &dof in &self.dofs.free {
+                self.u[dof] = tail.iter().zip(&weights).map(|(p, w)| w * p.1[dof]).sum();
+            }
+            let r = norm(&self.out_of_balance(body, forces, internal));
+            if r.is_finite() && r < best {
+                best = r;
+                chosen = Some(self.u.clone());
+            }
+        }
+        match chosen {
+            Some(u) => {
+                self.u = u;
+                true
+            }
+            None => {
+                self.u = current;
+                false
+            }
         }
     }
 
@@ -551,7 +650,7 @@ impl NewtonEquilibrium {
                     size.succeeded();
                 }
                 Err(failure) => {
-                    iterations += failure.history.len();
+                    iterations += failure.solves;
                     (self.u, self.lambda, self.previous) = (u0, l0, p0);
                     if !size.failed(body.newton.max_cuts) {
                         return Err(not_converged(body, target, &size, failure));
@@ -576,6 +675,7 @@ impl NewtonEquilibrium {
         let fail = |reason: String, history: &Vec<Real>| IncrementFailure {
             reason,
             history: history.clone(),
+            solves: history.len(),
         };
         if ref_norm == 0.0 {
             return Err(fail(
