@@ -583,17 +583,19 @@ fix = ["x", "y", "z"]
 
 /// Linear bodies factored once and condensed on their contact candidates give the answer of
 /// the coupled solve (every body's stiffness and the penalties factored together) on every
-/// bundled contact scene: displacements to 1e-7 of the largest, the same contacts at the end.
+/// bundled contact scene: displacements to 1e-6 of the largest (both stop at an out-of-balance
+/// of 1e-10 of the forces; the penalties, a hundred times the member stiffness, amplify that
+/// into the displacements), the same contacts at the end.
 /// The stack is left out: its contact set flips between two sets at the box edges (both solves
 /// warn so) and the set kept depends on the path of iterations (the answers differ by 1e-4 of
 /// the largest displacement); `stack_of_three_boxes_passes_the_load_down` checks its balance.
 #[test]
 fn condensed_and_coupled_solves_agree_on_the_bundled_scenes() {
     for (scene, tolerance) in [
-        ("scenes/two_disks.toml", 1e-7),
-        ("scenes/disk_on_floor.toml", 1e-7),
-        ("scenes/shell_on_block.toml", 1e-7),
-        ("scenes/shell_on_block_moving.toml", 1e-7),
+        ("scenes/two_disks.toml", 1e-6),
+        ("scenes/disk_on_floor.toml", 1e-6),
+        ("scenes/shell_on_block.toml", 1e-6),
+        ("scenes/shell_on_block_moving.toml", 1e-6),
     ] {
         let mut world = load_scene(Path::new(scene)).unwrap();
         assert!(world.bodies.iter().all(|b| !b.is_nonlinear()), "{scene}");

@@ -63,6 +63,9 @@ pub(crate) struct CondensedBody {
     /// Time of ordering and symbolic analysis, of the factorization and compliance, and of the
     /// pattern solves, s.
     pub seconds: [Real; 3],
+    /// The largest diagonal entry of the stiffness, N/m: the force a displacement error of the
+    /// interior makes.
+    pub stiffness: Real,
 }
 
 impl CondensedBody {
@@ -130,6 +133,9 @@ impl CondensedBody {
                 }
             }
         }
+        let largest_diagonal = (0..n)
+            .map(|c| values[assembly.col_ptr[c]])
+            .fold(0.0, Real::max);
         cholesky.factorize(&values).map_err(|e| e.to_string())?;
         let (order, factor) = cholesky
             .trailing_factor(m)
@@ -200,6 +206,7 @@ impl CondensedBody {
             cholesky,
             patterns: Vec::new(),
             seconds: [symbolic, numeric + relief, 0.0],
+            stiffness: largest_diagonal,
         };
         // One solve per schedule of loads and prescribed displacements.
         let mut schedules: Vec<Schedule> = Vec::new();

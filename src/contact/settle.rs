@@ -122,6 +122,8 @@ pub struct ContactSolver {
     /// Every body linear: each factored once per run and condensed on its contact candidates
     /// (`None`: the coupled solve).
     condensed: Option<Vec<Condensation>>,
+    /// The factored Jacobian of the condensed contact problem and the set it was made for.
+    condensed_jacobian: Option<(ContactSet, crate::contact::condensed::ContactJacobian)>,
     /// Time spent so far in each phase, s.
     pub times: PhaseTimes,
     /// Time spent so far finding contacts (projecting nodes on obstacles), s.
@@ -227,6 +229,7 @@ impl ContactSolver {
             coupling: Vec::new(),
             obstacles: obstacle_set,
             condensed,
+            condensed_jacobian: None,
             system,
             settings,
             active: ContactSet::default(),
@@ -344,9 +347,9 @@ impl ContactSolver {
                 found = self.query(bodies, &offsets);
                 self.query_seconds += t.elapsed().as_secs_f64();
                 // The placement was off by the compliance's round-off (a penalty turns 1e-13 m
-                // into forces the tolerance sees): Newton again from the solve, which returns
-                // at once when the residual there is within the tolerance.
-                if found == set && differs > 1e-12 && refinements < 3 {
+                // into forces the tolerance sees): above a tenth of the tolerance, Newton again
+                // from the solve, which returns at once when the residual there is within it.
+                if found == set && differs > 1e-11 && refinements < 3 {
                     refinements += 1;
                     continue;
                 }
@@ -388,6 +391,7 @@ impl ContactSolver {
         }
         self.active = set;
         self.expand_condensed();
+        self.condensed_solved(step);
         self.finish(bodies, &forces, &offsets, step, out)
     }
 

@@ -11,6 +11,7 @@ use crate::contact::{penetration_tolerance, ContactError, ContactSet, Obstacles}
 use crate::linkage::{Body, DofMap, StiffnessAssembly};
 use crate::Real;
 use nalgebra::Vector3;
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// A linear body's condensed state within the settle loop.
@@ -28,6 +29,9 @@ pub(super) struct Condensation {
     pub(super) alpha_expanded: Vec<Real>,
     /// Load plus contact forces per free DOF at the last full solve, N.
     pub(super) rhs_expanded: Vec<Real>,
+    /// The last two solved steps: (step, f̂, α), oldest first (the next step starts from their
+    /// extrapolation).
+    pub(super) history: Vec<(usize, Vec<Real>, Vec<Real>)>,
     /// Whether the bodies' displacements are those of the last full solve (no placement since).
     pub(super) fresh: bool,
 }
@@ -117,6 +121,7 @@ impl Condensation {
             expanded: vec![0.0; dofs],
             alpha_expanded: vec![0.0; r],
             rhs_expanded: vec![0.0; body.slot.len()],
+            history: Vec::new(),
             fresh: false,
             body,
         }
@@ -146,10 +151,36 @@ impl ContactSolver {
                 c.alpha_expanded.iter_mut().for_each(|v| *v = 0.0);
                 c.expanded.iter_mut().for_each(|v| *v = 0.0);
                 c.rhs_expanded.iter_mut().for_each(|v| *v = 0.0);
+                c.history.clear();
+            }
+            // Start from the straight line through the last two solved steps (exact for loads
+            // that grow in proportion while the contacts stay): Newton then only corrects.
+            if let [(s0, f0, a0), (s1, f1, a1)] = &c.history[..] {
+                if *s1 + 1 == step && *s0 + 1 == *s1 && f1.len() == c.fhat.len() {
+                    for (v, (x1, x0)) in c.fhat.iter_mut().zip(f1.iter().zip(f0)) {
+                        *v = 2.0 * x1 - x0;
+                    }
+                    for (v, (x1, x0)) in c.alpha.iter_mut().zip(a1.iter().zip(a0)) {
+                        *v = 2.0 * x1 - x0;
+                    }
+                }
             }
             let (load, base) = c.body.step_load(step, steps);
             c.load = load;
             c.base = base;
+            c.fresh = false;
+        }
+    }
+
+    /// Remember the solved state of `step` for the next step's start.
+    pub(super) fn condensed_solved(&mut self, step: usize) {
+        if let Some(condensed) = self.condensed.as_mut() {
+            for c in condensed.iter_mut() {
+                if c.history.len() == 2 {
+                    c.history.remove(0);
+                }
+                c.history.push((step, c.fhat.clone(), c.alpha.clone()));
+            }
         }
     }
 
@@ -203,7 +234,10 @@ impl ContactSolver {
     /// The dense compliance places the candidates to its own round-off (which grows with the
     /// condition of the body's stiffness); the difference to the solve is folded into the
     /// base displacement so that later placements reproduce the solve exactly. Returns that
-    /// difference relative to the largest candidate displacement (0 when nothing changed).
+    /// difference as a force, the largest stiffness times the largest difference, relative to
+    /// the largest load or contact force norm of a body (0 when nothing changed). The
+    /// candidates keep their placed values, so the contact forces are Newton's; the difference
+    /// only unbalances the members next to them.
     pub(super) fn expand_condensed(&mut self) -> Real {
         let t = Instant::now();
         let Some(condensed) = self.condensed.as_mut() else {
@@ -212,53 +246,63 @@ impl ContactSolver {
         if condensed.iter().all(|c| c.fresh) {
             return 0.0;
         }
-        let (mut differs, mut largest): (Real, Real) = (0.0, 0.0);
-        for (part, c) in self.parts.iter_mut().zip(condensed.iter_mut()) {
-            c.fresh = true;
-            let mut rhs = c.load.clone();
-            for (s, &i) in c.body.cand.iter().enumerate() {
-                rhs[i] += c.fhat[s];
-            }
-            let change: Vec<Real> = rhs
-                .iter()
-                .zip(&c.rhs_expanded)
-                .map(|(a, b)| a - b)
-                .collect();
-            let dalpha: Vec<Real> = c
-                .alpha
-                .iter()
-                .zip(&c.alpha_expanded)
-                .map(|(a, b)| a - b)
-                .collect();
-            let du = c.body.expand(&change, &dalpha);
-            let u: Vec<Real> = part
-                .dofs
-                .free
-                .iter()
-                .zip(&du)
-                .map(|(&dof, d)| c.expanded[dof] + d)
-                .collect();
-            c.rhs_expanded = rhs;
-            // The candidates keep their placed values: the contact forces were balanced there,
-            // and a penalty turns a last-bit difference of a position into a visible force.
-            for (s, &i) in c.body.cand.iter().enumerate() {
-                let placed = part.u[part.dofs.free[i]];
-                differs = differs.max((u[i] - placed).abs());
-                largest = largest.max(u[i].abs());
-                c.base[s] += u[i] - placed;
-            }
-            for (i, &dof) in part.dofs.free.iter().enumerate() {
-                if c.body.slot[i] == NOT_CANDIDATE {
-                    part.u[dof] = u[i];
+        let norm = |v: &[Real]| v.iter().map(|x| x * x).sum::<Real>().sqrt();
+        // One solve per body, the bodies side by side.
+        let each: Vec<(Real, Real)> = self
+            .parts
+            .par_iter_mut()
+            .zip(condensed.par_iter_mut())
+            .map(|(part, c)| {
+                let mut differs: Real = 0.0;
+                c.fresh = true;
+                let mut rhs = c.load.clone();
+                for (s, &i) in c.body.cand.iter().enumerate() {
+                    rhs[i] += c.fhat[s];
                 }
-            }
-            // The next solve adds to the solved displacement (placed values aside).
-            c.expanded.clone_from(&part.u);
-            for &i in &c.body.cand {
-                c.expanded[part.dofs.free[i]] = u[i];
-            }
-            c.alpha_expanded.clone_from(&c.alpha);
-        }
+                let change: Vec<Real> = rhs
+                    .iter()
+                    .zip(&c.rhs_expanded)
+                    .map(|(a, b)| a - b)
+                    .collect();
+                let dalpha: Vec<Real> = c
+                    .alpha
+                    .iter()
+                    .zip(&c.alpha_expanded)
+                    .map(|(a, b)| a - b)
+                    .collect();
+                let du = c.body.expand(&change, &dalpha);
+                let u: Vec<Real> = part
+                    .dofs
+                    .free
+                    .iter()
+                    .zip(&du)
+                    .map(|(&dof, d)| c.expanded[dof] + d)
+                    .collect();
+                c.rhs_expanded = rhs;
+                // The candidates keep their placed values: the contact forces were balanced
+                // there, and a penalty turns a last-bit difference of a position into a force.
+                let largest = norm(&c.load).max(norm(&c.fhat));
+                for (s, &i) in c.body.cand.iter().enumerate() {
+                    let placed = part.u[part.dofs.free[i]];
+                    differs = differs.max(c.body.stiffness * (u[i] - placed).abs());
+                    c.base[s] += u[i] - placed;
+                }
+                for (i, &dof) in part.dofs.free.iter().enumerate() {
+                    if c.body.slot[i] == NOT_CANDIDATE {
+                        part.u[dof] = u[i];
+                    }
+                }
+                // The next solve adds to the solved displacement (placed values aside).
+                c.expanded.clone_from(&part.u);
+                for &i in &c.body.cand {
+                    c.expanded[part.dofs.free[i]] = u[i];
+                }
+                c.alpha_expanded.clone_from(&c.alpha);
+                (differs, largest)
+            })
+            .collect();
+        let differs = each.iter().map(|e| e.0).fold(0.0, Real::max);
+        let largest = each.iter().map(|e| e.1).fold(0.0, Real::max);
         self.times.solve += t.elapsed().as_secs_f64();
         if largest > 0.0 {
             differs / largest
@@ -363,6 +407,24 @@ impl ContactSolver {
         }
     }
 
+    /// The displacements at every body's candidates as placed, m.
+    fn candidate_displacements(&self) -> Vec<Vec<Real>> {
+        let Some(condensed) = self.condensed.as_ref() else {
+            return Vec::new();
+        };
+        condensed
+            .iter()
+            .zip(&self.parts)
+            .map(|(c, part)| {
+                c.body
+                    .cand
+                    .iter()
+                    .map(|&i| part.u[part.dofs.free[i]])
+                    .collect()
+            })
+            .collect()
+    }
+
     /// The largest nodal displacement at the candidates, m.
     fn candidate_norm(&self) -> Real {
         let mut largest: Real = 0.0;
@@ -432,6 +494,8 @@ impl ContactSolver {
                 fhat[grown.slot[i]] = c.fhat[s];
             }
             c.fhat = fhat;
+            c.history.clear();
+            c.fresh = false;
             c.body = grown;
         }
         if ok {
@@ -442,7 +506,8 @@ impl ContactSolver {
 
     /// Newton on the candidates with the contact set fixed (see [`ContactSolver::newton`] for
     /// the meaning of the result). Falls back to the coupled solve when a body cannot be
-    /// condensed on the nodes the contacts reach.
+    /// condensed on the nodes the contacts reach. The factored Jacobian of a set is kept for
+    /// the next call with the same set (the next step, or a refinement after the full solve).
     pub(super) fn newton_condensed(
         &mut self,
         bodies: &[Body],
@@ -450,6 +515,27 @@ impl ContactSolver {
         forces: &[Vec<Real>],
         offsets: &[Vector3<Real>],
         step: usize,
+    ) -> Result<(usize, bool), ContactError> {
+        let mut jacobian = self
+            .condensed_jacobian
+            .take()
+            .filter(|(s, _)| s == set)
+            .map(|(_, j)| j);
+        let result = self.newton_condensed_with(bodies, set, forces, offsets, step, &mut jacobian);
+        if self.condensed.is_some() {
+            self.condensed_jacobian = jacobian.map(|j| (set.clone(), j));
+        }
+        result
+    }
+
+    fn newton_condensed_with(
+        &mut self,
+        bodies: &[Body],
+        set: &ContactSet,
+        forces: &[Vec<Real>],
+        offsets: &[Vector3<Real>],
+        step: usize,
+        jacobian: &mut Option<ContactJacobian>,
     ) -> Result<(usize, bool), ContactError> {
         let tolerance = bodies
             .iter()
@@ -470,19 +556,24 @@ impl ContactSolver {
         let mut history: Vec<Real> = Vec::new();
         let mut iterations = 0;
         let mut last_step = Real::INFINITY;
-        let mut jacobian: Option<ContactJacobian> = None;
         let fresh = self
             .condensed
             .as_ref()
             .is_some_and(|c| c.iter().all(|c| c.fresh));
+        // The residual of the state the line search accepted (evaluated there already).
+        let mut pending = None;
         loop {
             let t = Instant::now();
-            let evaluated = self.condensed_residual(bodies, set, forces, offsets);
+            let evaluated = match pending.take() {
+                Some(e) => Ok(e),
+                None => self.condensed_residual(bodies, set, forces, offsets),
+            };
             self.times.assembly += t.elapsed().as_secs_f64();
             let (phi1, phi2, rnorm, scale, rows) = match evaluated {
                 Ok(e) => e,
                 Err(missing) => {
                     if !missing.is_empty() && self.grow_candidates(bodies, &missing) {
+                        *jacobian = None;
                         continue;
                     }
                     return self.fall_back(bodies, set, forces, offsets, step);
@@ -522,14 +613,15 @@ impl ContactSolver {
             // Modified Newton: keep the factored Jacobian while it converges fast (the contacts'
             // normals and weights move little within one contact set).
             // Near the round-off floor the Jacobian's age no longer matters.
+            // A Jacobian carried over from an earlier call is tried once.
             let reuse = jacobian.as_ref().is_some_and(|j: &ContactJacobian| {
                 j.rows().len() == rows.len()
-                    && history.len() >= 2
-                    && (history[history.len() - 1] < 0.1 * history[history.len() - 2]
+                    && (history.len() < 2
+                        || history[history.len() - 1] < 0.1 * history[history.len() - 2]
                         || relative < 1e3 * tolerance)
             });
             if !reuse {
-                jacobian = match ContactJacobian::new(&views, rows, stabilisation) {
+                *jacobian = match ContactJacobian::new(&views, rows, stabilisation) {
                     Ok(j) => Some(j),
                     Err(_) => return self.fall_back(bodies, set, forces, offsets, step),
                 };
@@ -552,18 +644,16 @@ impl ContactSolver {
                     return Ok((iterations, false));
                 }
             }
+            let before = self.candidate_displacements();
             // Backtracking on the residual norm (Armijo, 1e-4): s = 1, 1/2, … 1/16.
             let mut best = (Real::INFINITY, 1.0);
             let mut s = 1.0;
-            let mut accepted = false;
             for _ in 0..5 {
                 self.apply_correction(&base, &corr, s);
-                let r = match self.condensed_residual(bodies, set, forces, offsets) {
-                    Ok((_, _, r, _, _)) => r,
-                    Err(_) => Real::INFINITY,
-                };
+                let trial = self.condensed_residual(bodies, set, forces, offsets);
+                let r = trial.as_ref().map_or(Real::INFINITY, |e| e.2);
                 if r.is_finite() && r <= (1.0 - 1e-4 * s) * rnorm {
-                    accepted = true;
+                    pending = trial.ok();
                     break;
                 }
                 if r < best.0 {
@@ -571,11 +661,20 @@ impl ContactSolver {
                 }
                 s *= 0.5;
             }
-            if !accepted {
+            if pending.is_none() {
                 self.apply_correction(&base, &corr, best.1);
-                s = best.1;
+                self.place_condensed();
             }
-            last_step = s * self.condensed_move(&corr);
+            last_step = before
+                .iter()
+                .zip(self.candidate_displacements())
+                .flat_map(|(a, b)| {
+                    a.iter()
+                        .zip(b)
+                        .map(|(x, y)| (x - y).abs())
+                        .collect::<Vec<_>>()
+                })
+                .fold(0.0, Real::max);
         }
     }
 
