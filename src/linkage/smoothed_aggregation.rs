@@ -6,7 +6,15 @@
 //! Jacobi step smooths it, `P = (I − ω D⁻¹A) P₀`; the coarse matrix is `PᵀAP`. Levels repeat
 //! until the matrix is small enough to factor. One V-cycle with Chebyshev smoothing (a fixed
 //! polynomial in `D⁻¹A`, so the cycle is symmetric) is one application of the preconditioner.
+//!
+//! The smoother multiplies by a single-precision block copy of each level whose DOFs come in
+//! uniform blocks (see [`BlockMatrix`]): a fixed symmetric matrix `Ã` within 2⁻²⁴ of `A`
+//! entry by entry, so the cycle stays a symmetric positive definite preconditioner while
+//! reading about a third of the memory per product; conjugate gradients keep multiplying by
+//! `A` in double precision. The copy is taken when the hierarchy is built: a hierarchy kept
+//! for a refilled matrix smooths with the values it was built for.
 
+use crate::linkage::block_matrix::BlockMatrix;
 use crate::linkage::cholesky::SparseCholesky;
 use crate::linkage::{dot, Preconditioner, SymmetricCsr};
 use crate::Real;
@@ -134,10 +142,93 @@ impl RowAccumulator {
     }
 }
 
-/// One level of the hierarchy: its matrix (except on the finest, which the caller owns), the
-/// smoother's data, and the transfer to the next level.
+/// The products a smoother needs from its level's matrix.
+trait Product: Sync {
+    /// `y = A x`.
+    fn multiply(&self, x: &[Real], y: &mut [Real]);
+    /// `r = b − A x`.
+    fn residual(&self, b: &[Real], x: &[Real], r: &mut [Real]);
+    /// `r −= A x`.
+    fn subtract_product(&self, x: &[Real], r: &mut [Real]);
+}
+
+impl Product for SymmetricCsr {
+    fn multiply(&self, x: &[Real], y: &mut [Real]) {
+        SymmetricCsr::multiply(self, x, y);
+    }
+    fn residual(&self, b: &[Real], x: &[Real], r: &mut [Real]) {
+        SymmetricCsr::residual(self, b, x, r);
+    }
+    fn subtract_product(&self, x: &[Real], r: &mut [Real]) {
+        SymmetricCsr::subtract_product(self, x, r);
+    }
+}
+
+impl<const B: usize> Product for BlockMatrix<B> {
+    fn multiply(&self, x: &[Real], y: &mut [Real]) {
+        BlockMatrix::multiply(self, x, y);
+    }
+    fn residual(&self, b: &[Real], x: &[Real], r: &mut [Real]) {
+        BlockMatrix::residual(self, b, x, r);
+    }
+    fn subtract_product(&self, x: &[Real], r: &mut [Real]) {
+        BlockMatrix::subtract_product(self, x, r);
+    }
+}
+
+/// The matrix a level's smoother multiplies by: a single-precision block copy when the level's
+/// DOFs come in uniform blocks (3D or 2D nodes all free, aggregates all of full rank), else the
+/// full rows in double precision.
+enum SmootherMatrix {
+    Rows,
+    Blocks2(BlockMatrix<2>),
+    Blocks3(BlockMatrix<3>),
+    Blocks6(BlockMatrix<6>),
+}
+
+impl SmootherMatrix {
+    /// The block copy of `a` for blocks starting at `blocks` (with a final entry `n`), if
+    /// they are uniform and the pattern allows it.
+    fn new(a: &SymmetricCsr, blocks: &[usize]) -> Self {
+        let width = blocks.get(1).map_or(0, |b| b - blocks[0]);
+        if blocks.windows(2).any(|w| w[1] - w[0] != width) {
+            return SmootherMatrix::Rows;
+        }
+        let built = match width {
+            2 => BlockMatrix::from_full_rows(a).map(SmootherMatrix::Blocks2),
+            3 => BlockMatrix::from_full_rows(a).map(SmootherMatrix::Blocks3),
+            6 => BlockMatrix::from_full_rows(a).map(SmootherMatrix::Blocks6),
+            _ => None,
+        };
+        built.unwrap_or(SmootherMatrix::Rows)
+    }
+
+    /// The product to use: the block copy, or `rows` (the level's full rows).
+    fn product<'a>(&'a self, rows: &'a SymmetricCsr) -> &'a dyn Product {
+        match self {
+            SmootherMatrix::Rows => rows,
+            SmootherMatrix::Blocks2(m) => m,
+            SmootherMatrix::Blocks3(m) => m,
+            SmootherMatrix::Blocks6(m) => m,
+        }
+    }
+}
+
+/// Vectors one V-cycle needs on a level, kept between cycles.
+#[derive(Default)]
+struct Work {
+    r: Vec<Real>,
+    d: Vec<Real>,
+    coarse_b: Vec<Real>,
+    coarse_x: Vec<Real>,
+}
+
+/// One level of the hierarchy: its smoother's matrix (full rows only when the smoother uses
+/// them and the level is not the finest, which the caller owns), the smoother's data, and the
+/// transfer to the next level.
 struct Level {
     matrix: Option<SymmetricCsr>,
+    smoother: SmootherMatrix,
     inverse_diagonal: Vec<Real>,
     lambda_max: Real,
     prolongator: AggregateRows,
@@ -147,6 +238,11 @@ struct Level {
 }
 
 impl Level {
+    /// The smoother's product (`fine` is the finest matrix).
+    fn product<'a>(&'a self, fine: &'a SymmetricCsr) -> &'a dyn Product {
+        self.smoother.product(self.matrix.as_ref().unwrap_or(fine))
+    }
+
     /// `x += P xc`.
     fn prolong_add(&self, coarse: &[Real], x: &mut [Real]) {
         let p = &self.prolongator;
@@ -195,6 +291,7 @@ impl Level {
 /// The multigrid hierarchy: apply it with [`SmoothedAggregation::apply`].
 pub struct SmoothedAggregation {
     levels: Vec<Level>,
+    work: Vec<Work>,
     coarse: SparseCholesky,
     /// Unknowns per level, finest first (the last is factored).
     pub sizes: Vec<usize>,
@@ -289,7 +386,8 @@ impl SmoothedAggregation {
                     }
                 })
                 .collect::<Result<Vec<_>, _>>()?;
-            let lambda_max = largest_eigenvalue(a, &inverse_diagonal);
+            let smoother = SmootherMatrix::new(a, &blocks);
+            let lambda_max = largest_eigenvalue(smoother.product(a), &inverse_diagonal);
             let aggregates = aggregate(a, &blocks);
             let count = aggregates
                 .iter()
@@ -310,8 +408,13 @@ impl SmoothedAggregation {
             sizes.push(coarse.n);
             let mut coarse_blocks = numbering.offset.clone();
             coarse_blocks.push(coarse.n);
+            let own = current.take();
             levels.push(Level {
-                matrix: current.take(),
+                matrix: match smoother {
+                    SmootherMatrix::Rows => own,
+                    _ => None,
+                },
+                smoother,
                 inverse_diagonal,
                 lambda_max,
                 prolongator,
@@ -333,8 +436,10 @@ impl SmoothedAggregation {
         coarse
             .factorize(&values)
             .map_err(|e| MultigridError::Coarse(e.to_string()))?;
+        let work = (0..levels.len()).map(|_| Work::default()).collect();
         Ok(SmoothedAggregation {
             levels,
+            work,
             coarse,
             sizes,
         })
@@ -347,41 +452,47 @@ impl SmoothedAggregation {
             self.coarse.solve_in_place(x);
             return;
         }
-        x.iter_mut().for_each(|v| *v = 0.0);
-        let mut r = b.to_vec();
-        let mut coarse_b;
-        let mut coarse_x;
+        let mut w = std::mem::take(&mut self.work[level]);
+        let n = b.len();
+        for v in [&mut w.r, &mut w.d] {
+            v.resize(n, 0.0);
+        }
+        let coarse_n = self.sizes[level + 1];
+        w.coarse_b.resize(coarse_n, 0.0);
+        w.coarse_x.resize(coarse_n, 0.0);
         {
             let lv = &self.levels[level];
-            let a = lv.matrix.as_ref().unwrap_or(fine);
-            chebyshev(a, &lv.inverse_diagonal, lv.lambda_max, b, x, &mut r, true);
-            a.multiply(x, &mut r);
-            r.par_iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
-            coarse_b = vec![
-                0.0;
-                lv.numbering.offset.last().map_or(0, |o| *o)
-                    + lv.numbering.rank.last().map_or(0, |r| *r)
-            ];
-            lv.restrict(&r, &mut coarse_b);
-            coarse_x = vec![0.0; coarse_b.len()];
+            let a = lv.product(fine);
+            chebyshev(a, &lv.inverse_diagonal, lv.lambda_max, b, x, &mut w, true);
+            a.residual(b, x, &mut w.r);
+            lv.restrict(&w.r, &mut w.coarse_b);
         }
-        self.cycle(level + 1, fine, &coarse_b, &mut coarse_x);
+        self.cycle(level + 1, fine, &w.coarse_b, &mut w.coarse_x);
         let lv = &self.levels[level];
-        let a = lv.matrix.as_ref().unwrap_or(fine);
-        lv.prolong_add(&coarse_x, x);
-        chebyshev(a, &lv.inverse_diagonal, lv.lambda_max, b, x, &mut r, false);
+        lv.prolong_add(&w.coarse_x, x);
+        chebyshev(
+            lv.product(fine),
+            &lv.inverse_diagonal,
+            lv.lambda_max,
+            b,
+            x,
+            &mut w,
+            false,
+        );
+        self.work[level] = w;
     }
 }
 
 /// Chebyshev smoothing of `A x = b` with the Jacobi-scaled polynomial on
-/// `[λmax / RATIO, 1.1 λmax]`. When `zero_start`, x is zero and `r` already holds b.
+/// `[λmax / RATIO, 1.1 λmax]`, using `w.r` and `w.d`. When `zero_start`, x is zero on
+/// entry and is overwritten.
 fn chebyshev(
-    a: &SymmetricCsr,
+    a: &dyn Product,
     inverse_diagonal: &[Real],
     lambda_max: Real,
     b: &[Real],
     x: &mut [Real],
-    r: &mut [Real],
+    w: &mut Work,
     zero_start: bool,
 ) {
     let upper = 1.1 * lambda_max;
@@ -390,30 +501,38 @@ fn chebyshev(
     let delta = 0.5 * (upper - lower);
     let sigma = theta / delta;
     let mut rho = 1.0 / sigma;
+    let (r, d) = (&mut w.r, &mut w.d);
     if zero_start {
+        // x = d = D⁻¹ b / θ, r = b.
         r.copy_from_slice(b);
+        d.par_iter_mut()
+            .zip(x.par_iter_mut())
+            .zip(b.par_iter().zip(inverse_diagonal))
+            .for_each(|((di, xi), (bi, inv))| {
+                *di = bi * inv / theta;
+                *xi = *di;
+            });
     } else {
-        a.multiply(x, r);
-        r.par_iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
+        a.residual(b, x, r);
+        d.par_iter_mut()
+            .zip(x.par_iter_mut())
+            .zip(r.par_iter().zip(inverse_diagonal))
+            .for_each(|((di, xi), (ri, inv))| {
+                *di = ri * inv / theta;
+                *xi += *di;
+            });
     }
-    let mut d: Vec<Real> = r
-        .iter()
-        .zip(inverse_diagonal)
-        .map(|(ri, di)| ri * di / theta)
-        .collect();
-    let mut ad = vec![0.0; d.len()];
-    for k in 0..SMOOTHER_DEGREE {
-        x.par_iter_mut().zip(&d).for_each(|(xi, di)| *xi += di);
-        if k + 1 == SMOOTHER_DEGREE {
-            break;
-        }
-        a.multiply(&d, &mut ad);
-        r.par_iter_mut().zip(&ad).for_each(|(ri, adi)| *ri -= adi);
+    for _ in 1..SMOOTHER_DEGREE {
+        a.subtract_product(d, r);
         let rho_next = 1.0 / (2.0 * sigma - rho);
         let (c1, c2) = (rho_next * rho, 2.0 * rho_next / delta);
         d.par_iter_mut()
+            .zip(x.par_iter_mut())
             .zip(r.par_iter().zip(inverse_diagonal))
-            .for_each(|(di, (ri, inv))| *di = c1 * *di + c2 * inv * ri);
+            .for_each(|((di, xi), (ri, inv))| {
+                *di = c1 * *di + c2 * inv * ri;
+                *xi += *di;
+            });
         rho = rho_next;
     }
 }
@@ -421,8 +540,8 @@ fn chebyshev(
 /// λmax of `D⁻¹A` by 10 Lanczos steps on the similar symmetric `D^-½ A D^-½`: Lanczos finds
 /// the extreme eigenvalue far faster than power iteration, and an estimate that is too low
 /// would let the Chebyshev smoother amplify the highest modes.
-fn largest_eigenvalue(a: &SymmetricCsr, inverse_diagonal: &[Real]) -> Real {
-    let n = a.n;
+fn largest_eigenvalue(a: &dyn Product, inverse_diagonal: &[Real]) -> Real {
+    let n = inverse_diagonal.len();
     let scale: Vec<Real> = inverse_diagonal.iter().map(|d| d.sqrt()).collect();
     let mut v: Vec<Real> = (0..n)
         .map(|i| 1.0 + ((i * 7919) % 17) as Real / 17.0)
@@ -656,8 +775,9 @@ fn galerkin(
     numbering: &CoarseNumbering,
 ) -> SymmetricCsr {
     let count = numbering.rank.len();
-    // AP row by row, per aggregate.
-    let chunks = (0..a.n.div_ceil(ROWS_PER_TASK))
+    // AP row by row, per aggregate, kept in its chunks (row i in chunk i / ROWS_PER_TASK):
+    // joining them would hold AP twice at the peak of the set-up.
+    let ap: Vec<RowChunk> = (0..a.n.div_ceil(ROWS_PER_TASK))
         .into_par_iter()
         .map(|chunk| {
             let mut acc = RowAccumulator::new(count);
@@ -674,7 +794,18 @@ fn galerkin(
             out
         })
         .collect();
-    let ap = concatenate(chunks);
+    // Where each row of AP starts in its chunk.
+    let ap_starts: Vec<Vec<usize>> = ap
+        .par_iter()
+        .map(|(lengths, _, _)| {
+            let mut starts = Vec::with_capacity(lengths.len() + 1);
+            starts.push(0);
+            for l in lengths {
+                starts.push(starts[starts.len() - 1] + l);
+            }
+            starts
+        })
+        .collect();
     // Block row g of PᵀAP = Σ over fine rows i touching g of P[i, g]ᵀ · AP[i, :].
     let (start, pairs) = transpose;
     const GROUPS_PER_TASK: usize = 64;
@@ -688,9 +819,10 @@ fn galerkin(
             for g in chunk * GROUPS_PER_TASK..((chunk + 1) * GROUPS_PER_TASK).min(count) {
                 for &(i, e) in &pairs[start[g]..start[g + 1]] {
                     let pv = &p.value[e as usize];
-                    let i = i as usize;
-                    for f in ap.row_ptr[i]..ap.row_ptr[i + 1] {
-                        let h = ap.aggregate[f];
+                    let (chunk, local) = (i as usize / ROWS_PER_TASK, i as usize % ROWS_PER_TASK);
+                    let (_, ap_aggregates, ap_values) = &ap[chunk];
+                    let range = ap_starts[chunk][local]..ap_starts[chunk][local + 1];
+                    for (&h, av) in ap_aggregates[range.clone()].iter().zip(&ap_values[range]) {
                         let slot = &mut place[h as usize];
                         if *slot == u32::MAX {
                             *slot = touched.len() as u32;
@@ -698,7 +830,6 @@ fn galerkin(
                             blocks.push([[0.0; MODES]; MODES]);
                         }
                         let block = &mut blocks[*slot as usize];
-                        let av = &ap.value[f];
                         for (row, &pt) in block.iter_mut().zip(pv) {
                             for (x, &y) in row.iter_mut().zip(av) {
                                 *x += pt * y;
@@ -732,6 +863,7 @@ fn galerkin(
         })
         .collect();
     drop(ap);
+    drop(ap_starts);
     let n: usize = numbering.rank.iter().sum();
     let nnz: usize = rows.iter().map(|c| c.1.len()).sum();
     let mut row_ptr = Vec::with_capacity(n + 1);

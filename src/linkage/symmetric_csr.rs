@@ -133,6 +133,27 @@ impl SymmetricCsr {
     /// `y = A x`, rows in parallel; each row is summed in a fixed order, so the result does
     /// not depend on the number of threads.
     pub fn multiply(&self, x: &[Real], y: &mut [Real]) {
+        self.for_each_row_product(x, y, |yi, ax| *yi = ax);
+    }
+
+    /// `r = b − A x` in one pass.
+    pub fn residual(&self, b: &[Real], x: &[Real], r: &mut [Real]) {
+        r.copy_from_slice(b);
+        self.subtract_product(x, r);
+    }
+
+    /// `r −= A x` in one pass.
+    pub fn subtract_product(&self, x: &[Real], r: &mut [Real]) {
+        self.for_each_row_product(x, r, |ri, ax| *ri -= ax);
+    }
+
+    /// Calls `update(y_i, (A x)_i)` for every row, rows in parallel.
+    fn for_each_row_product(
+        &self,
+        x: &[Real],
+        y: &mut [Real],
+        update: impl Fn(&mut Real, Real) + Sync,
+    ) {
         y.par_chunks_mut(ROWS_PER_TASK)
             .enumerate()
             .for_each(|(chunk, out)| {
@@ -140,14 +161,29 @@ impl SymmetricCsr {
                 for (k, yi) in out.iter_mut().enumerate() {
                     let i = first + k;
                     let range = self.row_ptr[i]..self.row_ptr[i + 1];
-                    *yi = self.col[range.clone()]
-                        .iter()
-                        .zip(&self.val[range])
-                        .map(|(&c, &v)| v * x[c as usize])
-                        .sum();
+                    update(yi, row_times(&self.col[range.clone()], &self.val[range], x));
                 }
             });
     }
+}
+
+/// `Σ val_k x[col_k]` with four interleaved partial sums (a single chain of additions would
+/// bound the product by the adder's latency, not by memory), combined in a fixed order.
+#[inline(always)]
+fn row_times(col: &[u32], val: &[Real], x: &[Real]) -> Real {
+    let mut acc = [0.0; 4];
+    let mut cols = col.chunks_exact(4);
+    let mut vals = val.chunks_exact(4);
+    for (c, v) in (&mut cols).zip(&mut vals) {
+        for k in 0..4 {
+            acc[k] += v[k] * x[c[k] as usize];
+        }
+    }
+    let mut sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (&c, &v) in cols.remainder().iter().zip(vals.remainder()) {
+        sum += v * x[c as usize];
+    }
+    sum
 }
 
 /// An approximate inverse of a symmetric positive definite matrix, applied once per
