@@ -9,7 +9,7 @@ use crate::Real;
 use rayon::prelude::*;
 
 /// Block rows handed to one parallel task.
-const BLOCK_ROWS_PER_TASK: usize = 512;
+pub const BLOCK_ROWS_PER_TASK: usize = 512;
 
 /// A square matrix of `B×B` blocks in compressed block rows, values in `f32`.
 #[derive(Clone, Debug)]

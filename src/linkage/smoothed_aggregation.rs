@@ -14,7 +14,7 @@
 //! `A` in double precision. The copy is taken when the hierarchy is built: a hierarchy kept
 //! for a refilled matrix smooths with the values it was built for.
 
-use crate::linkage::block_matrix::BlockMatrix;
+use crate::linkage::block_matrix::{BlockMatrix, BLOCK_ROWS_PER_TASK};
 use crate::linkage::cholesky::SparseCholesky;
 use crate::linkage::{dot, Preconditioner, SymmetricCsr};
 use crate::Real;
@@ -223,6 +223,44 @@ struct Work {
     coarse_x: Vec<Real>,
 }
 
+/// The prolongator as the cycle uses it, in single precision (the Galerkin product used the
+/// double-precision one): by fine rows for prolongation and by aggregates for restriction, so
+/// that both read their values in order.
+struct Transfer {
+    /// Per fine row, its entries `row_ptr[i]..row_ptr[i + 1]` in `row_entries`.
+    row_ptr: Vec<usize>,
+    /// (aggregate, `MODES` values) of each entry by rows.
+    row_entries: Vec<(u32, [f32; MODES])>,
+    /// Per aggregate, its entries `aggregate_ptr[g]..aggregate_ptr[g + 1]` in `aggregate_entries`.
+    aggregate_ptr: Vec<usize>,
+    /// (fine row, `MODES` values) of each entry by aggregates.
+    aggregate_entries: Vec<(u32, [f32; MODES])>,
+}
+
+impl Transfer {
+    /// The single-precision copy of `p`, with its transpose `by_aggregate(p)`.
+    fn new(p: &AggregateRows, transpose: &(Vec<usize>, Vec<(u32, u32)>)) -> Self {
+        let single = |v: &[Real; MODES]| v.map(|x| x as f32);
+        let row_entries = p
+            .aggregate
+            .par_iter()
+            .zip(&p.value)
+            .map(|(&g, v)| (g, single(v)))
+            .collect();
+        let (start, pairs) = transpose;
+        let aggregate_entries = pairs
+            .par_iter()
+            .map(|&(i, e)| (i, single(&p.value[e as usize])))
+            .collect();
+        Transfer {
+            row_ptr: p.row_ptr.clone(),
+            row_entries,
+            aggregate_ptr: start.clone(),
+            aggregate_entries,
+        }
+    }
+}
+
 /// One level of the hierarchy: its smoother's matrix (full rows only when the smoother uses
 /// them and the level is not the finest, which the caller owns), the smoother's data, and the
 /// transfer to the next level.
@@ -231,10 +269,8 @@ struct Level {
     smoother: SmootherMatrix,
     inverse_diagonal: Vec<Real>,
     lambda_max: Real,
-    prolongator: AggregateRows,
+    transfer: Transfer,
     numbering: CoarseNumbering,
-    /// `by_aggregate` of the prolongator: start per aggregate, (fine row, entry) pairs.
-    transpose: (Vec<usize>, Vec<(u32, u32)>),
 }
 
 impl Level {
@@ -245,7 +281,7 @@ impl Level {
 
     /// `x += P xc`.
     fn prolong_add(&self, coarse: &[Real], x: &mut [Real]) {
-        let p = &self.prolongator;
+        let p = &self.transfer;
         let nb = &self.numbering;
         x.par_chunks_mut(ROWS_PER_TASK)
             .enumerate()
@@ -253,11 +289,10 @@ impl Level {
                 let first = chunk * ROWS_PER_TASK;
                 for (k, xi) in out.iter_mut().enumerate() {
                     let i = first + k;
-                    for e in p.row_ptr[i]..p.row_ptr[i + 1] {
-                        let g = p.aggregate[e] as usize;
-                        let v = &p.value[e];
+                    for (g, v) in &p.row_entries[p.row_ptr[i]..p.row_ptr[i + 1]] {
+                        let g = *g as usize;
                         let c = &coarse[nb.offset[g]..nb.offset[g] + nb.rank[g]];
-                        *xi += c.iter().zip(v).map(|(a, b)| a * b).sum::<Real>();
+                        *xi += c.iter().zip(v).map(|(a, b)| a * *b as Real).sum::<Real>();
                     }
                 }
             });
@@ -265,18 +300,17 @@ impl Level {
 
     /// `bc = Pᵀ r`, aggregates in parallel.
     fn restrict(&self, r: &[Real], coarse: &mut [Real]) {
-        let (start, pairs) = &self.transpose;
-        let p = &self.prolongator;
+        let p = &self.transfer;
         let nb = &self.numbering;
         let sums: Vec<[Real; MODES]> = (0..nb.rank.len())
             .into_par_iter()
             .with_min_len(256)
             .map(|g| {
                 let mut acc = [0.0; MODES];
-                for &(i, e) in &pairs[start[g]..start[g + 1]] {
-                    let ri = r[i as usize];
-                    for (a, v) in acc.iter_mut().zip(&p.value[e as usize]) {
-                        *a += v * ri;
+                for (i, v) in &p.aggregate_entries[p.aggregate_ptr[g]..p.aggregate_ptr[g + 1]] {
+                    let ri = r[*i as usize];
+                    for (a, v) in acc.iter_mut().zip(v) {
+                        *a += *v as Real * ri;
                     }
                 }
                 acc
@@ -401,13 +435,42 @@ impl SmoothedAggregation {
             let (tentative, numbering, coarse_null) =
                 tentative_prolongator(&blocks, &aggregates, count, &null_space);
             let omega = 4.0 / (3.0 * lambda_max);
-            let prolongator = smooth_prolongator(a, &inverse_diagonal, omega, &tentative, count);
+            let prolongator = match &smoother {
+                SmootherMatrix::Blocks3(m) => concatenate(block_product(
+                    m,
+                    &tentative,
+                    count,
+                    |i| -omega * inverse_diagonal[i],
+                    Some(&tentative),
+                )),
+                SmootherMatrix::Blocks6(m) => concatenate(block_product(
+                    m,
+                    &tentative,
+                    count,
+                    |i| -omega * inverse_diagonal[i],
+                    Some(&tentative),
+                )),
+                _ => smooth_prolongator(a, &inverse_diagonal, omega, &tentative, count),
+            };
             drop(tentative);
             let transpose = by_aggregate(&prolongator, count);
-            let coarse = galerkin(a, &prolongator, &transpose, &numbering);
+            let (ap, ap_rows_per_chunk) = match &smoother {
+                SmootherMatrix::Blocks3(m) => (
+                    block_product(m, &prolongator, count, |_| 1.0, None),
+                    3 * BLOCK_ROWS_PER_TASK,
+                ),
+                SmootherMatrix::Blocks6(m) => (
+                    block_product(m, &prolongator, count, |_| 1.0, None),
+                    6 * BLOCK_ROWS_PER_TASK,
+                ),
+                _ => (product_by_rows(a, &prolongator, count), ROWS_PER_TASK),
+            };
+            let coarse = galerkin(ap, ap_rows_per_chunk, &prolongator, &transpose, &numbering);
             sizes.push(coarse.n);
             let mut coarse_blocks = numbering.offset.clone();
             coarse_blocks.push(coarse.n);
+            let transfer = Transfer::new(&prolongator, &transpose);
+            drop((prolongator, transpose));
             let own = current.take();
             levels.push(Level {
                 matrix: match smoother {
@@ -417,9 +480,8 @@ impl SmoothedAggregation {
                 smoother,
                 inverse_diagonal,
                 lambda_max,
-                prolongator,
+                transfer,
                 numbering,
-                transpose,
             });
             current = Some(coarse);
             null_space = coarse_null;
@@ -767,17 +829,93 @@ fn smooth_prolongator(
     concatenate(chunks)
 }
 
-/// The Galerkin coarse matrix `PᵀAP`, as full rows.
-fn galerkin(
-    a: &SymmetricCsr,
+/// `A P` for the block copy `a` (block rows of `W` rows), in chunks of `W · BLOCK_ROWS_PER_TASK`
+/// rows; each row of `A P` is then scaled by `scale(row)` and, when `add` is given, the row
+/// of `add` is added. With the rows of one block sharing their pattern in `p` (true of the
+/// tentative prolongator and of every product of this function), one aggregate lookup serves
+/// a whole `W×W` block times `W×MODES` values.
+fn block_product<const W: usize>(
+    a: &BlockMatrix<W>,
     p: &AggregateRows,
-    transpose: &(Vec<usize>, Vec<(u32, u32)>),
-    numbering: &CoarseNumbering,
-) -> SymmetricCsr {
-    let count = numbering.rank.len();
-    // AP row by row, per aggregate, kept in its chunks (row i in chunk i / ROWS_PER_TASK):
-    // joining them would hold AP twice at the peak of the set-up.
-    let ap: Vec<RowChunk> = (0..a.n.div_ceil(ROWS_PER_TASK))
+    count: usize,
+    scale: impl Fn(usize) -> Real + Sync,
+    add: Option<&AggregateRows>,
+) -> Vec<RowChunk> {
+    (0..a.blocks.div_ceil(BLOCK_ROWS_PER_TASK))
+        .into_par_iter()
+        .map(|chunk| {
+            let mut place = vec![u32::MAX; count];
+            let mut touched: Vec<u32> = Vec::new();
+            let mut sums: Vec<[[Real; MODES]; W]> = Vec::new();
+            let mut out: RowChunk = (Vec::new(), Vec::new(), Vec::new());
+            let rows =
+                chunk * BLOCK_ROWS_PER_TASK..((chunk + 1) * BLOCK_ROWS_PER_TASK).min(a.blocks);
+            for block_row in rows {
+                let range = a.row_ptr[block_row]..a.row_ptr[block_row + 1];
+                for (&c, block) in a.col[range.clone()].iter().zip(&a.val[range]) {
+                    let base = W * c as usize;
+                    let first = p.row_ptr[base];
+                    let length = p.row_ptr[base + 1] - first;
+                    for k in 0..length {
+                        let g = p.aggregate[first + k];
+                        let slot = &mut place[g as usize];
+                        if *slot == u32::MAX {
+                            *slot = touched.len() as u32;
+                            touched.push(g);
+                            sums.push([[0.0; MODES]; W]);
+                        }
+                        let target = &mut sums[*slot as usize];
+                        for (b, row_b) in (0..W).map(|b| (b, &p.value[p.row_ptr[base + b] + k])) {
+                            for (t, block_row_a) in target.iter_mut().zip(block) {
+                                let v = block_row_a[b] as Real;
+                                for (x, y) in t.iter_mut().zip(row_b) {
+                                    *x += v * y;
+                                }
+                            }
+                        }
+                    }
+                }
+                for (i, row) in (W * block_row..W * block_row + W).enumerate() {
+                    let factor = scale(row);
+                    for s in sums.iter_mut() {
+                        s[i].iter_mut().for_each(|x| *x *= factor);
+                    }
+                    if let Some(add) = add {
+                        for e in add.row_ptr[row]..add.row_ptr[row + 1] {
+                            let g = add.aggregate[e];
+                            let slot = &mut place[g as usize];
+                            if *slot == u32::MAX {
+                                *slot = touched.len() as u32;
+                                touched.push(g);
+                                sums.push([[0.0; MODES]; W]);
+                            }
+                            let target = &mut sums[*slot as usize][i];
+                            for (x, y) in target.iter_mut().zip(&add.value[e]) {
+                                *x += y;
+                            }
+                        }
+                    }
+                }
+                for i in 0..W {
+                    out.0.push(touched.len());
+                    out.1.extend_from_slice(&touched);
+                    out.2.extend(sums.iter().map(|s| s[i]));
+                }
+                for &g in &touched {
+                    place[g as usize] = u32::MAX;
+                }
+                touched.clear();
+                sums.clear();
+            }
+            out
+        })
+        .collect()
+}
+
+/// The Galerkin coarse matrix `PᵀAP`, as full rows.
+/// `A P` row by row, per aggregate, in chunks of `ROWS_PER_TASK` rows.
+fn product_by_rows(a: &SymmetricCsr, p: &AggregateRows, count: usize) -> Vec<RowChunk> {
+    (0..a.n.div_ceil(ROWS_PER_TASK))
         .into_par_iter()
         .map(|chunk| {
             let mut acc = RowAccumulator::new(count);
@@ -793,7 +931,20 @@ fn galerkin(
             }
             out
         })
-        .collect();
+        .collect()
+}
+
+/// The Galerkin coarse matrix `PᵀAP`, as full rows, from `ap` = `A P` in chunks of
+/// `rows_per_chunk` rows (kept in its chunks: joining them would hold `A P` twice at the peak
+/// of the set-up).
+fn galerkin(
+    ap: Vec<RowChunk>,
+    rows_per_chunk: usize,
+    p: &AggregateRows,
+    transpose: &(Vec<usize>, Vec<(u32, u32)>),
+    numbering: &CoarseNumbering,
+) -> SymmetricCsr {
+    let count = numbering.rank.len();
     // Where each row of AP starts in its chunk.
     let ap_starts: Vec<Vec<usize>> = ap
         .par_iter()
@@ -819,7 +970,7 @@ fn galerkin(
             for g in chunk * GROUPS_PER_TASK..((chunk + 1) * GROUPS_PER_TASK).min(count) {
                 for &(i, e) in &pairs[start[g]..start[g + 1]] {
                     let pv = &p.value[e as usize];
-                    let (chunk, local) = (i as usize / ROWS_PER_TASK, i as usize % ROWS_PER_TASK);
+                    let (chunk, local) = (i as usize / rows_per_chunk, i as usize % rows_per_chunk);
                     let (_, ap_aggregates, ap_values) = &ap[chunk];
                     let range = ap_starts[chunk][local]..ap_starts[chunk][local + 1];
                     for (&h, av) in ap_aggregates[range.clone()].iter().zip(&ap_values[range]) {
