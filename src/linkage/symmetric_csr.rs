@@ -21,8 +21,9 @@ pub struct SymmetricCsr {
     pub col: Vec<u32>,
     /// Value of each entry.
     pub val: Vec<Real>,
-    /// For each lower-triangle entry, its places in `val` (upper place = lower place on the diagonal).
-    from_lower: Vec<[u32; 2]>,
+    /// For each entry of `val`, the lower-triangle entry it copies: refilling is a gather,
+    /// every entry written once, in parallel.
+    source: Vec<u32>,
 }
 
 impl SymmetricCsr {
@@ -45,7 +46,7 @@ impl SymmetricCsr {
         let nnz = row_ptr[n];
         let mut next = count;
         let mut col = vec![0u32; nnz];
-        let mut from_lower = vec![[0u32; 2]; row_idx.len()];
+        let mut source = vec![0u32; nnz];
         // Column by column, so every row receives its columns in ascending order.
         for c in 0..n {
             for (k, &r) in row_idx[col_ptr[c]..col_ptr[c + 1]].iter().enumerate() {
@@ -53,15 +54,13 @@ impl SymmetricCsr {
                 let lower = next[r];
                 col[lower] = c as u32;
                 next[r] += 1;
-                let upper = if r != c {
+                source[lower] = e as u32;
+                if r != c {
                     let p = next[c];
                     col[p] = r as u32;
+                    source[p] = e as u32;
                     next[c] += 1;
-                    p
-                } else {
-                    lower
-                };
-                from_lower[e] = [lower as u32, upper as u32];
+                }
             }
         }
         // Row i receives its columns j < i while columns j are visited, then i and every r > i
@@ -71,7 +70,7 @@ impl SymmetricCsr {
             row_ptr,
             col,
             val: vec![0.0; nnz],
-            from_lower,
+            source,
         };
         csr.check_sorted();
         csr
@@ -85,7 +84,7 @@ impl SymmetricCsr {
             row_ptr,
             col,
             val,
-            from_lower: Vec::new(),
+            source: Vec::new(),
         };
         csr.check_sorted();
         csr
@@ -101,19 +100,25 @@ impl SymmetricCsr {
 
     /// Copy the lower-triangle values (in the assembly's order) into both triangles.
     pub fn refill(&mut self, lower_values: &[Real]) {
-        for (v, places) in lower_values.iter().zip(&self.from_lower) {
-            self.val[places[0] as usize] = *v;
-            self.val[places[1] as usize] = *v;
-        }
+        self.val
+            .par_chunks_mut(ROWS_PER_TASK * 32)
+            .zip(self.source.par_chunks(ROWS_PER_TASK * 32))
+            .for_each(|(values, sources)| {
+                for (v, &e) in values.iter_mut().zip(sources) {
+                    *v = lower_values[e as usize];
+                }
+            });
     }
 
     /// The lower-triangle values in the order they were given to [`SymmetricCsr::refill`].
     pub fn lower_values(&self, count: usize) -> Vec<Real> {
-        self.from_lower
-            .iter()
-            .take(count)
-            .map(|places| self.val[places[0] as usize])
-            .collect()
+        let mut lower = vec![0.0; count];
+        for (&v, &e) in self.val.iter().zip(&self.source) {
+            if let Some(slot) = lower.get_mut(e as usize) {
+                *slot = v;
+            }
+        }
+        lower
     }
 
     /// The diagonal entry of every row.
@@ -218,6 +223,11 @@ mod tests {
         assert_eq!(a.row_ptr, vec![0, 2, 5, 7]);
         assert_eq!(a.col, vec![0, 1, 0, 1, 2, 1, 2]);
         assert_eq!(a.diagonal(), vec![4.0, 5.0, 6.0]);
+        assert_eq!(a.val, vec![4.0, 1.0, 1.0, 5.0, 2.0, 2.0, 6.0]);
+        assert_eq!(a.lower_values(5), vec![4.0, 1.0, 5.0, 2.0, 6.0]);
+        let mut r = vec![0.0; 3];
+        a.residual(&[10.0, 20.0, 30.0], &[1.0, 2.0, 3.0], &mut r);
+        assert_eq!(r, vec![4.0, 3.0, 8.0]);
         let mut y = vec![0.0; 3];
         a.multiply(&[1.0, 2.0, 3.0], &mut y);
         assert_eq!(y, vec![6.0, 17.0, 22.0]);
