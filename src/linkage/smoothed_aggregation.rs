@@ -454,18 +454,27 @@ impl SmoothedAggregation {
             };
             drop(tentative);
             let transpose = by_aggregate(&prolongator, count);
-            let (ap, ap_rows_per_chunk) = match &smoother {
+            let (ap, ap_rows_per_chunk, width) = match &smoother {
                 SmootherMatrix::Blocks3(m) => (
                     block_product(m, &prolongator, count, |_| 1.0, None),
                     3 * BLOCK_ROWS_PER_TASK,
+                    3,
                 ),
                 SmootherMatrix::Blocks6(m) => (
                     block_product(m, &prolongator, count, |_| 1.0, None),
                     6 * BLOCK_ROWS_PER_TASK,
+                    6,
                 ),
-                _ => (product_by_rows(a, &prolongator, count), ROWS_PER_TASK),
+                _ => (product_by_rows(a, &prolongator, count), ROWS_PER_TASK, 1),
             };
-            let coarse = galerkin(ap, ap_rows_per_chunk, &prolongator, &transpose, &numbering);
+            let coarse = galerkin(
+                ap,
+                ap_rows_per_chunk,
+                width,
+                &prolongator,
+                &transpose,
+                &numbering,
+            );
             sizes.push(coarse.n);
             let mut coarse_blocks = numbering.offset.clone();
             coarse_blocks.push(coarse.n);
@@ -935,11 +944,13 @@ fn product_by_rows(a: &SymmetricCsr, p: &AggregateRows, count: usize) -> Vec<Row
 }
 
 /// The Galerkin coarse matrix `PᵀAP`, as full rows, from `ap` = `A P` in chunks of
-/// `rows_per_chunk` rows (kept in its chunks: joining them would hold `A P` twice at the peak
+/// `rows_per_chunk` rows, whose rows come in blocks of `width` rows sharing their pattern
+/// in `P` and in `A P` (kept in its chunks: joining them would hold `A P` twice at the peak
 /// of the set-up).
 fn galerkin(
     ap: Vec<RowChunk>,
     rows_per_chunk: usize,
+    width: usize,
     p: &AggregateRows,
     transpose: &(Vec<usize>, Vec<(u32, u32)>),
     numbering: &CoarseNumbering,
@@ -968,12 +979,22 @@ fn galerkin(
             let mut blocks: Vec<[[Real; MODES]; MODES]> = Vec::new();
             let mut out = (Vec::new(), Vec::new(), Vec::new());
             for g in chunk * GROUPS_PER_TASK..((chunk + 1) * GROUPS_PER_TASK).min(count) {
-                for &(i, e) in &pairs[start[g]..start[g + 1]] {
-                    let pv = &p.value[e as usize];
-                    let (chunk, local) = (i as usize / rows_per_chunk, i as usize % rows_per_chunk);
-                    let (_, ap_aggregates, ap_values) = &ap[chunk];
-                    let range = ap_starts[chunk][local]..ap_starts[chunk][local + 1];
-                    for (&h, av) in ap_aggregates[range.clone()].iter().zip(&ap_values[range]) {
+                // The rows of one block, consecutive here, share their pattern in AP.
+                for group in pairs[start[g]..start[g + 1]].chunks(width) {
+                    // Per row of the group: its chunk of AP, where its row starts there, and
+                    // its entry of P.
+                    let mut rows = [(0usize, 0usize, 0usize); MODES];
+                    for (slot, &(i, e)) in rows.iter_mut().zip(group) {
+                        let (chunk, local) =
+                            (i as usize / rows_per_chunk, i as usize % rows_per_chunk);
+                        *slot = (chunk, ap_starts[chunk][local], e as usize);
+                    }
+                    let rows = &rows[..group.len()];
+                    let (chunk, first, _) = rows[0];
+                    let length =
+                        ap_starts[chunk][(group[0].0 as usize % rows_per_chunk) + 1] - first;
+                    let pattern = &ap[chunk].1[first..first + length];
+                    for (k, &h) in pattern.iter().enumerate() {
                         let slot = &mut place[h as usize];
                         if *slot == u32::MAX {
                             *slot = touched.len() as u32;
@@ -981,9 +1002,13 @@ fn galerkin(
                             blocks.push([[0.0; MODES]; MODES]);
                         }
                         let block = &mut blocks[*slot as usize];
-                        for (row, &pt) in block.iter_mut().zip(pv) {
-                            for (x, &y) in row.iter_mut().zip(av) {
-                                *x += pt * y;
+                        for &(chunk, first, e) in rows {
+                            let av = &ap[chunk].2[first + k];
+                            debug_assert_eq!(ap[chunk].1[first + k], h);
+                            for (row, &pt) in block.iter_mut().zip(&p.value[e]) {
+                                for (x, &y) in row.iter_mut().zip(av) {
+                                    *x += pt * y;
+                                }
                             }
                         }
                     }

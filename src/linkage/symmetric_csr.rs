@@ -124,13 +124,13 @@ impl SymmetricCsr {
     /// The diagonal entry of every row.
     pub fn diagonal(&self) -> Vec<Real> {
         (0..self.n)
+            .into_par_iter()
+            .with_min_len(ROWS_PER_TASK)
             .map(|i| {
-                let range = self.row_ptr[i]..self.row_ptr[i + 1];
-                self.col[range.clone()]
-                    .iter()
-                    .zip(&self.val[range])
-                    .find(|(c, _)| **c as usize == i)
-                    .map_or(0.0, |(_, v)| *v)
+                let start = self.row_ptr[i];
+                self.col[start..self.row_ptr[i + 1]]
+                    .binary_search(&(i as u32))
+                    .map_or(0.0, |k| self.val[start + k])
             })
             .collect()
     }
