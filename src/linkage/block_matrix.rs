@@ -29,7 +29,7 @@ impl<const B: usize> BlockMatrix<B> {
     /// pattern is made of whole `B×B` blocks aligned on multiples of `B` (every row of a block
     /// row holding the same columns).
     pub fn from_full_rows(a: &SymmetricCsr) -> Option<Self> {
-        if a.n % B != 0 {
+        if !a.n.is_multiple_of(B) {
             return None;
         }
         let blocks = a.n / B;
@@ -40,11 +40,11 @@ impl<const B: usize> BlockMatrix<B> {
             .all(|block_row| {
                 let first = B * block_row;
                 let cols = &a.col[a.row_ptr[first]..a.row_ptr[first + 1]];
-                cols.len() % B == 0
+                cols.len().is_multiple_of(B)
                     && (first + 1..first + B)
                         .all(|r| a.col[a.row_ptr[r]..a.row_ptr[r + 1]] == *cols)
                     && cols.chunks_exact(B).all(|group| {
-                        group[0] as usize % B == 0
+                        (group[0] as usize).is_multiple_of(B)
                             && group.iter().zip(group[0]..).all(|(&g, e)| g == e)
                     })
             });
