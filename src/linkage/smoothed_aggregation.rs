@@ -1128,6 +1128,28 @@ mod tests {
             .fold(0.0, Real::max);
         assert!(err <= 1e-8 * scale, "{err:e} of {scale:e}");
 
+        // Built and applied on one thread, the hierarchy gives the same bits.
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let (single, one) = pool.install(|| {
+            let mut amg = SmoothedAggregation::with_coarse_size(
+                &csr,
+                &asm.groups,
+                &directions,
+                &body.nodes,
+                3,
+                200,
+            )
+            .unwrap();
+            let mut one = vec![0.0; asm.n];
+            let r = conjugate_gradient(&csr, &mut amg, &b, &mut one, CgSettings::default());
+            (r, one)
+        });
+        assert_eq!(single.iterations, report.iterations);
+        assert_eq!(one, x);
+
         let mut jacobi = BlockJacobi::new(&csr, &asm.groups).unwrap();
         let mut y = vec![0.0; asm.n];
         let plain = conjugate_gradient(&csr, &mut jacobi, &b, &mut y, CgSettings::default());
