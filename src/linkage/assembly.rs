@@ -1,6 +1,7 @@
 use crate::linkage::{Body, DofMap, DofSlot};
 use crate::Real;
 use nalgebra::Matrix3;
+use rayon::prelude::*;
 
 /// Marks a block entry that does not land in `K_ff` (one of its DOFs is supported).
 const NOT_FREE: u32 = u32::MAX;
@@ -105,15 +106,26 @@ impl StiffnessAssembly {
                 limit: NOT_FREE as usize - 1,
             });
         }
-        let mut row_idx = Vec::with_capacity(nnz);
-        for &dof in &dofs.free {
-            let (j, q) = dofs.node_and_direction(dof);
-            row_idx.extend((q..d).filter_map(|p| local(j, p)));
-            for &i in &neighbours[start[j]..start[j + 1]] {
-                row_idx.extend((0..d).filter_map(|p| local(i, p)));
-            }
+        // Columns are independent: split row_idx at column starts and fill them in parallel.
+        let mut row_idx = vec![0usize; nnz];
+        let mut columns = Vec::with_capacity(n);
+        let mut rest = row_idx.as_mut_slice();
+        for c in 0..n {
+            let (column, tail) = rest.split_at_mut(col_ptr[c + 1] - col_ptr[c]);
+            columns.push((dofs.free[c], column));
+            rest = tail;
         }
-        debug_assert_eq!(row_idx.len(), nnz);
+        columns.into_par_iter().for_each(|(dof, column)| {
+            let (j, q) = dofs.node_and_direction(dof);
+            let rows = (q..d).filter_map(|p| local(j, p)).chain(
+                neighbours[start[j]..start[j + 1]]
+                    .iter()
+                    .flat_map(|&i| (0..d).filter_map(move |p| local(i, p))),
+            );
+            for (slot, r) in column.iter_mut().zip(rows) {
+                *slot = r;
+            }
+        });
 
         let mut diagonal = vec![[NOT_FREE; 9]; nodes];
         for (j, places) in diagonal.iter_mut().enumerate() {
@@ -129,25 +141,29 @@ impl StiffnessAssembly {
             }
         }
         let mut cross = vec![[NOT_FREE; 9]; body.members.len()];
-        for (m, places) in body.members.iter().zip(cross.iter_mut()) {
-            let (lo, hi) = ordered(m.nodes);
-            if nfree[lo] == 0 || nfree[hi] == 0 {
-                continue;
-            }
-            let list = &neighbours[start[lo]..start[lo + 1]];
-            let e = start[lo] + list.partition_point(|&i| i < hi);
-            for q in 0..d {
-                let Some(c) = local(lo, q) else { continue };
-                let diag = (q..d).filter(|&p| local(lo, p).is_some()).count();
-                let mut offset = 0;
-                for p in 0..d {
-                    if local(hi, p).is_some() {
-                        places[3 * p + q] = (col_ptr[c] + diag + block_offset[e] + offset) as u32;
-                        offset += 1;
+        body.members
+            .par_iter()
+            .zip(cross.par_iter_mut())
+            .for_each(|(m, places)| {
+                let (lo, hi) = ordered(m.nodes);
+                if nfree[lo] == 0 || nfree[hi] == 0 {
+                    return;
+                }
+                let list = &neighbours[start[lo]..start[lo + 1]];
+                let e = start[lo] + list.partition_point(|&i| i < hi);
+                for q in 0..d {
+                    let Some(c) = local(lo, q) else { continue };
+                    let diag = (q..d).filter(|&p| local(lo, p).is_some()).count();
+                    let mut offset = 0;
+                    for p in 0..d {
+                        if local(hi, p).is_some() {
+                            places[3 * p + q] =
+                                (col_ptr[c] + diag + block_offset[e] + offset) as u32;
+                            offset += 1;
+                        }
                     }
                 }
-            }
-        }
+            });
         Ok(StiffnessAssembly {
             n,
             col_ptr,

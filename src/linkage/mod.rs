@@ -29,6 +29,7 @@ pub use self::symmetric_csr::{dot, Preconditioner, SymmetricCsr};
 
 mod assembly;
 mod block_jacobi;
+pub(crate) mod block_matrix;
 mod body;
 mod body_solver;
 pub mod cholesky;

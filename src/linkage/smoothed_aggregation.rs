@@ -6,7 +6,15 @@
 //! Jacobi step smooths it, `P = (I − ω D⁻¹A) P₀`; the coarse matrix is `PᵀAP`. Levels repeat
 //! until the matrix is small enough to factor. One V-cycle with Chebyshev smoothing (a fixed
 //! polynomial in `D⁻¹A`, so the cycle is symmetric) is one application of the preconditioner.
+//!
+//! The smoother multiplies by a single-precision block copy of each level whose DOFs come in
+//! uniform blocks (see [`BlockMatrix`]): a fixed symmetric matrix `Ã` within 2⁻²⁴ of `A`
+//! entry by entry, so the cycle stays a symmetric positive definite preconditioner while
+//! reading about a third of the memory per product; conjugate gradients keep multiplying by
+//! `A` in double precision. The copy is taken when the hierarchy is built: a hierarchy kept
+//! for a refilled matrix smooths with the values it was built for.
 
+use crate::linkage::block_matrix::{BlockMatrix, BLOCK_ROWS_PER_TASK};
 use crate::linkage::cholesky::SparseCholesky;
 use crate::linkage::{dot, Preconditioner, SymmetricCsr};
 use crate::Real;
@@ -134,22 +142,146 @@ impl RowAccumulator {
     }
 }
 
-/// One level of the hierarchy: its matrix (except on the finest, which the caller owns), the
-/// smoother's data, and the transfer to the next level.
+/// The products a smoother needs from its level's matrix.
+trait Product: Sync {
+    /// `y = A x`.
+    fn multiply(&self, x: &[Real], y: &mut [Real]);
+    /// `r = b − A x`.
+    fn residual(&self, b: &[Real], x: &[Real], r: &mut [Real]);
+    /// `r −= A x`.
+    fn subtract_product(&self, x: &[Real], r: &mut [Real]);
+}
+
+impl Product for SymmetricCsr {
+    fn multiply(&self, x: &[Real], y: &mut [Real]) {
+        SymmetricCsr::multiply(self, x, y);
+    }
+    fn residual(&self, b: &[Real], x: &[Real], r: &mut [Real]) {
+        SymmetricCsr::residual(self, b, x, r);
+    }
+    fn subtract_product(&self, x: &[Real], r: &mut [Real]) {
+        SymmetricCsr::subtract_product(self, x, r);
+    }
+}
+
+impl<const B: usize> Product for BlockMatrix<B> {
+    fn multiply(&self, x: &[Real], y: &mut [Real]) {
+        BlockMatrix::multiply(self, x, y);
+    }
+    fn residual(&self, b: &[Real], x: &[Real], r: &mut [Real]) {
+        BlockMatrix::residual(self, b, x, r);
+    }
+    fn subtract_product(&self, x: &[Real], r: &mut [Real]) {
+        BlockMatrix::subtract_product(self, x, r);
+    }
+}
+
+/// The matrix a level's smoother multiplies by: a single-precision block copy when the level's
+/// DOFs come in uniform blocks (3D or 2D nodes all free, aggregates all of full rank), else the
+/// full rows in double precision.
+enum SmootherMatrix {
+    Rows,
+    Blocks2(BlockMatrix<2>),
+    Blocks3(BlockMatrix<3>),
+    Blocks6(BlockMatrix<6>),
+}
+
+impl SmootherMatrix {
+    /// The block copy of `a` for blocks starting at `blocks` (with a final entry `n`), if
+    /// they are uniform and the pattern allows it.
+    fn new(a: &SymmetricCsr, blocks: &[usize]) -> Self {
+        let width = blocks.get(1).map_or(0, |b| b - blocks[0]);
+        if blocks.windows(2).any(|w| w[1] - w[0] != width) {
+            return SmootherMatrix::Rows;
+        }
+        let built = match width {
+            2 => BlockMatrix::from_full_rows(a).map(SmootherMatrix::Blocks2),
+            3 => BlockMatrix::from_full_rows(a).map(SmootherMatrix::Blocks3),
+            6 => BlockMatrix::from_full_rows(a).map(SmootherMatrix::Blocks6),
+            _ => None,
+        };
+        built.unwrap_or(SmootherMatrix::Rows)
+    }
+
+    /// The product to use: the block copy, or `rows` (the level's full rows).
+    fn product<'a>(&'a self, rows: &'a SymmetricCsr) -> &'a dyn Product {
+        match self {
+            SmootherMatrix::Rows => rows,
+            SmootherMatrix::Blocks2(m) => m,
+            SmootherMatrix::Blocks3(m) => m,
+            SmootherMatrix::Blocks6(m) => m,
+        }
+    }
+}
+
+/// Vectors one V-cycle needs on a level, kept between cycles.
+#[derive(Default)]
+struct Work {
+    r: Vec<Real>,
+    d: Vec<Real>,
+    coarse_b: Vec<Real>,
+    coarse_x: Vec<Real>,
+}
+
+/// The prolongator as the cycle uses it, in single precision (the Galerkin product used the
+/// double-precision one): by fine rows for prolongation and by aggregates for restriction, so
+/// that both read their values in order.
+struct Transfer {
+    /// Per fine row, its entries `row_ptr[i]..row_ptr[i + 1]` in `row_entries`.
+    row_ptr: Vec<usize>,
+    /// (aggregate, `MODES` values) of each entry by rows.
+    row_entries: Vec<(u32, [f32; MODES])>,
+    /// Per aggregate, its entries `aggregate_ptr[g]..aggregate_ptr[g + 1]` in `aggregate_entries`.
+    aggregate_ptr: Vec<usize>,
+    /// (fine row, `MODES` values) of each entry by aggregates.
+    aggregate_entries: Vec<(u32, [f32; MODES])>,
+}
+
+impl Transfer {
+    /// The single-precision copy of `p`, with its transpose `by_aggregate(p)`.
+    fn new(p: &AggregateRows, transpose: &(Vec<usize>, Vec<(u32, u32)>)) -> Self {
+        let single = |v: &[Real; MODES]| v.map(|x| x as f32);
+        let row_entries = p
+            .aggregate
+            .par_iter()
+            .zip(&p.value)
+            .map(|(&g, v)| (g, single(v)))
+            .collect();
+        let (start, pairs) = transpose;
+        let aggregate_entries = pairs
+            .par_iter()
+            .map(|&(i, e)| (i, single(&p.value[e as usize])))
+            .collect();
+        Transfer {
+            row_ptr: p.row_ptr.clone(),
+            row_entries,
+            aggregate_ptr: start.clone(),
+            aggregate_entries,
+        }
+    }
+}
+
+/// One level of the hierarchy: its smoother's matrix (full rows only when the smoother uses
+/// them and the level is not the finest, which the caller owns), the smoother's data, and the
+/// transfer to the next level.
 struct Level {
     matrix: Option<SymmetricCsr>,
+    smoother: SmootherMatrix,
     inverse_diagonal: Vec<Real>,
     lambda_max: Real,
-    prolongator: AggregateRows,
+    transfer: Transfer,
     numbering: CoarseNumbering,
-    /// `by_aggregate` of the prolongator: start per aggregate, (fine row, entry) pairs.
-    transpose: (Vec<usize>, Vec<(u32, u32)>),
 }
 
 impl Level {
+    /// The smoother's product (`fine` is the finest matrix).
+    fn product<'a>(&'a self, fine: &'a SymmetricCsr) -> &'a dyn Product {
+        self.smoother.product(self.matrix.as_ref().unwrap_or(fine))
+    }
+
     /// `x += P xc`.
     fn prolong_add(&self, coarse: &[Real], x: &mut [Real]) {
-        let p = &self.prolongator;
+        let p = &self.transfer;
         let nb = &self.numbering;
         x.par_chunks_mut(ROWS_PER_TASK)
             .enumerate()
@@ -157,11 +289,10 @@ impl Level {
                 let first = chunk * ROWS_PER_TASK;
                 for (k, xi) in out.iter_mut().enumerate() {
                     let i = first + k;
-                    for e in p.row_ptr[i]..p.row_ptr[i + 1] {
-                        let g = p.aggregate[e] as usize;
-                        let v = &p.value[e];
+                    for (g, v) in &p.row_entries[p.row_ptr[i]..p.row_ptr[i + 1]] {
+                        let g = *g as usize;
                         let c = &coarse[nb.offset[g]..nb.offset[g] + nb.rank[g]];
-                        *xi += c.iter().zip(v).map(|(a, b)| a * b).sum::<Real>();
+                        *xi += c.iter().zip(v).map(|(a, b)| a * *b as Real).sum::<Real>();
                     }
                 }
             });
@@ -169,18 +300,17 @@ impl Level {
 
     /// `bc = Pᵀ r`, aggregates in parallel.
     fn restrict(&self, r: &[Real], coarse: &mut [Real]) {
-        let (start, pairs) = &self.transpose;
-        let p = &self.prolongator;
+        let p = &self.transfer;
         let nb = &self.numbering;
         let sums: Vec<[Real; MODES]> = (0..nb.rank.len())
             .into_par_iter()
             .with_min_len(256)
             .map(|g| {
                 let mut acc = [0.0; MODES];
-                for &(i, e) in &pairs[start[g]..start[g + 1]] {
-                    let ri = r[i as usize];
-                    for (a, v) in acc.iter_mut().zip(&p.value[e as usize]) {
-                        *a += v * ri;
+                for (i, v) in &p.aggregate_entries[p.aggregate_ptr[g]..p.aggregate_ptr[g + 1]] {
+                    let ri = r[*i as usize];
+                    for (a, v) in acc.iter_mut().zip(v) {
+                        *a += *v as Real * ri;
                     }
                 }
                 acc
@@ -195,6 +325,7 @@ impl Level {
 /// The multigrid hierarchy: apply it with [`SmoothedAggregation::apply`].
 pub struct SmoothedAggregation {
     levels: Vec<Level>,
+    work: Vec<Work>,
     coarse: SparseCholesky,
     /// Unknowns per level, finest first (the last is factored).
     pub sizes: Vec<usize>,
@@ -289,7 +420,8 @@ impl SmoothedAggregation {
                     }
                 })
                 .collect::<Result<Vec<_>, _>>()?;
-            let lambda_max = largest_eigenvalue(a, &inverse_diagonal);
+            let smoother = SmootherMatrix::new(a, &blocks);
+            let lambda_max = largest_eigenvalue(smoother.product(a), &inverse_diagonal);
             let aggregates = aggregate(a, &blocks);
             let count = aggregates
                 .iter()
@@ -303,20 +435,62 @@ impl SmoothedAggregation {
             let (tentative, numbering, coarse_null) =
                 tentative_prolongator(&blocks, &aggregates, count, &null_space);
             let omega = 4.0 / (3.0 * lambda_max);
-            let prolongator = smooth_prolongator(a, &inverse_diagonal, omega, &tentative, count);
+            let prolongator = match &smoother {
+                SmootherMatrix::Blocks3(m) => concatenate(block_product(
+                    m,
+                    &tentative,
+                    count,
+                    |i| -omega * inverse_diagonal[i],
+                    Some(&tentative),
+                )),
+                SmootherMatrix::Blocks6(m) => concatenate(block_product(
+                    m,
+                    &tentative,
+                    count,
+                    |i| -omega * inverse_diagonal[i],
+                    Some(&tentative),
+                )),
+                _ => smooth_prolongator(a, &inverse_diagonal, omega, &tentative, count),
+            };
             drop(tentative);
             let transpose = by_aggregate(&prolongator, count);
-            let coarse = galerkin(a, &prolongator, &transpose, &numbering);
+            let (ap, ap_rows_per_chunk, width) = match &smoother {
+                SmootherMatrix::Blocks3(m) => (
+                    block_product(m, &prolongator, count, |_| 1.0, None),
+                    3 * BLOCK_ROWS_PER_TASK,
+                    3,
+                ),
+                SmootherMatrix::Blocks6(m) => (
+                    block_product(m, &prolongator, count, |_| 1.0, None),
+                    6 * BLOCK_ROWS_PER_TASK,
+                    6,
+                ),
+                _ => (product_by_rows(a, &prolongator, count), ROWS_PER_TASK, 1),
+            };
+            let coarse = galerkin(
+                ap,
+                ap_rows_per_chunk,
+                width,
+                &prolongator,
+                &transpose,
+                &numbering,
+            );
             sizes.push(coarse.n);
             let mut coarse_blocks = numbering.offset.clone();
             coarse_blocks.push(coarse.n);
+            let transfer = Transfer::new(&prolongator, &transpose);
+            drop((prolongator, transpose));
+            let own = current.take();
             levels.push(Level {
-                matrix: current.take(),
+                matrix: match smoother {
+                    SmootherMatrix::Rows => own,
+                    _ => None,
+                },
+                smoother,
                 inverse_diagonal,
                 lambda_max,
-                prolongator,
+                transfer,
                 numbering,
-                transpose,
             });
             current = Some(coarse);
             null_space = coarse_null;
@@ -333,8 +507,10 @@ impl SmoothedAggregation {
         coarse
             .factorize(&values)
             .map_err(|e| MultigridError::Coarse(e.to_string()))?;
+        let work = (0..levels.len()).map(|_| Work::default()).collect();
         Ok(SmoothedAggregation {
             levels,
+            work,
             coarse,
             sizes,
         })
@@ -347,41 +523,47 @@ impl SmoothedAggregation {
             self.coarse.solve_in_place(x);
             return;
         }
-        x.iter_mut().for_each(|v| *v = 0.0);
-        let mut r = b.to_vec();
-        let mut coarse_b;
-        let mut coarse_x;
+        let mut w = std::mem::take(&mut self.work[level]);
+        let n = b.len();
+        for v in [&mut w.r, &mut w.d] {
+            v.resize(n, 0.0);
+        }
+        let coarse_n = self.sizes[level + 1];
+        w.coarse_b.resize(coarse_n, 0.0);
+        w.coarse_x.resize(coarse_n, 0.0);
         {
             let lv = &self.levels[level];
-            let a = lv.matrix.as_ref().unwrap_or(fine);
-            chebyshev(a, &lv.inverse_diagonal, lv.lambda_max, b, x, &mut r, true);
-            a.multiply(x, &mut r);
-            r.par_iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
-            coarse_b = vec![
-                0.0;
-                lv.numbering.offset.last().map_or(0, |o| *o)
-                    + lv.numbering.rank.last().map_or(0, |r| *r)
-            ];
-            lv.restrict(&r, &mut coarse_b);
-            coarse_x = vec![0.0; coarse_b.len()];
+            let a = lv.product(fine);
+            chebyshev(a, &lv.inverse_diagonal, lv.lambda_max, b, x, &mut w, true);
+            a.residual(b, x, &mut w.r);
+            lv.restrict(&w.r, &mut w.coarse_b);
         }
-        self.cycle(level + 1, fine, &coarse_b, &mut coarse_x);
+        self.cycle(level + 1, fine, &w.coarse_b, &mut w.coarse_x);
         let lv = &self.levels[level];
-        let a = lv.matrix.as_ref().unwrap_or(fine);
-        lv.prolong_add(&coarse_x, x);
-        chebyshev(a, &lv.inverse_diagonal, lv.lambda_max, b, x, &mut r, false);
+        lv.prolong_add(&w.coarse_x, x);
+        chebyshev(
+            lv.product(fine),
+            &lv.inverse_diagonal,
+            lv.lambda_max,
+            b,
+            x,
+            &mut w,
+            false,
+        );
+        self.work[level] = w;
     }
 }
 
 /// Chebyshev smoothing of `A x = b` with the Jacobi-scaled polynomial on
-/// `[λmax / RATIO, 1.1 λmax]`. When `zero_start`, x is zero and `r` already holds b.
+/// `[λmax / RATIO, 1.1 λmax]`, using `w.r` and `w.d`. When `zero_start`, x is zero on
+/// entry and is overwritten.
 fn chebyshev(
-    a: &SymmetricCsr,
+    a: &dyn Product,
     inverse_diagonal: &[Real],
     lambda_max: Real,
     b: &[Real],
     x: &mut [Real],
-    r: &mut [Real],
+    w: &mut Work,
     zero_start: bool,
 ) {
     let upper = 1.1 * lambda_max;
@@ -390,30 +572,38 @@ fn chebyshev(
     let delta = 0.5 * (upper - lower);
     let sigma = theta / delta;
     let mut rho = 1.0 / sigma;
+    let (r, d) = (&mut w.r, &mut w.d);
     if zero_start {
+        // x = d = D⁻¹ b / θ, r = b.
         r.copy_from_slice(b);
+        d.par_iter_mut()
+            .zip(x.par_iter_mut())
+            .zip(b.par_iter().zip(inverse_diagonal))
+            .for_each(|((di, xi), (bi, inv))| {
+                *di = bi * inv / theta;
+                *xi = *di;
+            });
     } else {
-        a.multiply(x, r);
-        r.par_iter_mut().zip(b).for_each(|(ri, bi)| *ri = bi - *ri);
+        a.residual(b, x, r);
+        d.par_iter_mut()
+            .zip(x.par_iter_mut())
+            .zip(r.par_iter().zip(inverse_diagonal))
+            .for_each(|((di, xi), (ri, inv))| {
+                *di = ri * inv / theta;
+                *xi += *di;
+            });
     }
-    let mut d: Vec<Real> = r
-        .iter()
-        .zip(inverse_diagonal)
-        .map(|(ri, di)| ri * di / theta)
-        .collect();
-    let mut ad = vec![0.0; d.len()];
-    for k in 0..SMOOTHER_DEGREE {
-        x.par_iter_mut().zip(&d).for_each(|(xi, di)| *xi += di);
-        if k + 1 == SMOOTHER_DEGREE {
-            break;
-        }
-        a.multiply(&d, &mut ad);
-        r.par_iter_mut().zip(&ad).for_each(|(ri, adi)| *ri -= adi);
+    for _ in 1..SMOOTHER_DEGREE {
+        a.subtract_product(d, r);
         let rho_next = 1.0 / (2.0 * sigma - rho);
         let (c1, c2) = (rho_next * rho, 2.0 * rho_next / delta);
         d.par_iter_mut()
+            .zip(x.par_iter_mut())
             .zip(r.par_iter().zip(inverse_diagonal))
-            .for_each(|(di, (ri, inv))| *di = c1 * *di + c2 * inv * ri);
+            .for_each(|((di, xi), (ri, inv))| {
+                *di = c1 * *di + c2 * inv * ri;
+                *xi += *di;
+            });
         rho = rho_next;
     }
 }
@@ -421,8 +611,8 @@ fn chebyshev(
 /// λmax of `D⁻¹A` by 10 Lanczos steps on the similar symmetric `D^-½ A D^-½`: Lanczos finds
 /// the extreme eigenvalue far faster than power iteration, and an estimate that is too low
 /// would let the Chebyshev smoother amplify the highest modes.
-fn largest_eigenvalue(a: &SymmetricCsr, inverse_diagonal: &[Real]) -> Real {
-    let n = a.n;
+fn largest_eigenvalue(a: &dyn Product, inverse_diagonal: &[Real]) -> Real {
+    let n = inverse_diagonal.len();
     let scale: Vec<Real> = inverse_diagonal.iter().map(|d| d.sqrt()).collect();
     let mut v: Vec<Real> = (0..n)
         .map(|i| 1.0 + ((i * 7919) % 17) as Real / 17.0)
@@ -648,16 +838,93 @@ fn smooth_prolongator(
     concatenate(chunks)
 }
 
-/// The Galerkin coarse matrix `PᵀAP`, as full rows.
-fn galerkin(
-    a: &SymmetricCsr,
+/// `A P` for the block copy `a` (block rows of `W` rows), in chunks of `W · BLOCK_ROWS_PER_TASK`
+/// rows; each row of `A P` is then scaled by `scale(row)` and, when `add` is given, the row
+/// of `add` is added. With the rows of one block sharing their pattern in `p` (true of the
+/// tentative prolongator and of every product of this function), one aggregate lookup serves
+/// a whole `W×W` block times `W×MODES` values.
+fn block_product<const W: usize>(
+    a: &BlockMatrix<W>,
     p: &AggregateRows,
-    transpose: &(Vec<usize>, Vec<(u32, u32)>),
-    numbering: &CoarseNumbering,
-) -> SymmetricCsr {
-    let count = numbering.rank.len();
-    // AP row by row, per aggregate.
-    let chunks = (0..a.n.div_ceil(ROWS_PER_TASK))
+    count: usize,
+    scale: impl Fn(usize) -> Real + Sync,
+    add: Option<&AggregateRows>,
+) -> Vec<RowChunk> {
+    (0..a.blocks.div_ceil(BLOCK_ROWS_PER_TASK))
+        .into_par_iter()
+        .map(|chunk| {
+            let mut place = vec![u32::MAX; count];
+            let mut touched: Vec<u32> = Vec::new();
+            let mut sums: Vec<[[Real; MODES]; W]> = Vec::new();
+            let mut out: RowChunk = (Vec::new(), Vec::new(), Vec::new());
+            let rows =
+                chunk * BLOCK_ROWS_PER_TASK..((chunk + 1) * BLOCK_ROWS_PER_TASK).min(a.blocks);
+            for block_row in rows {
+                let range = a.row_ptr[block_row]..a.row_ptr[block_row + 1];
+                for (&c, block) in a.col[range.clone()].iter().zip(&a.val[range]) {
+                    let base = W * c as usize;
+                    let first = p.row_ptr[base];
+                    let length = p.row_ptr[base + 1] - first;
+                    for k in 0..length {
+                        let g = p.aggregate[first + k];
+                        let slot = &mut place[g as usize];
+                        if *slot == u32::MAX {
+                            *slot = touched.len() as u32;
+                            touched.push(g);
+                            sums.push([[0.0; MODES]; W]);
+                        }
+                        let target = &mut sums[*slot as usize];
+                        for (b, row_b) in (0..W).map(|b| (b, &p.value[p.row_ptr[base + b] + k])) {
+                            for (t, block_row_a) in target.iter_mut().zip(block) {
+                                let v = block_row_a[b] as Real;
+                                for (x, y) in t.iter_mut().zip(row_b) {
+                                    *x += v * y;
+                                }
+                            }
+                        }
+                    }
+                }
+                for (i, row) in (W * block_row..W * block_row + W).enumerate() {
+                    let factor = scale(row);
+                    for s in sums.iter_mut() {
+                        s[i].iter_mut().for_each(|x| *x *= factor);
+                    }
+                    if let Some(add) = add {
+                        for e in add.row_ptr[row]..add.row_ptr[row + 1] {
+                            let g = add.aggregate[e];
+                            let slot = &mut place[g as usize];
+                            if *slot == u32::MAX {
+                                *slot = touched.len() as u32;
+                                touched.push(g);
+                                sums.push([[0.0; MODES]; W]);
+                            }
+                            let target = &mut sums[*slot as usize][i];
+                            for (x, y) in target.iter_mut().zip(&add.value[e]) {
+                                *x += y;
+                            }
+                        }
+                    }
+                }
+                for i in 0..W {
+                    out.0.push(touched.len());
+                    out.1.extend_from_slice(&touched);
+                    out.2.extend(sums.iter().map(|s| s[i]));
+                }
+                for &g in &touched {
+                    place[g as usize] = u32::MAX;
+                }
+                touched.clear();
+                sums.clear();
+            }
+            out
+        })
+        .collect()
+}
+
+/// The Galerkin coarse matrix `PᵀAP`, as full rows.
+/// `A P` row by row, per aggregate, in chunks of `ROWS_PER_TASK` rows.
+fn product_by_rows(a: &SymmetricCsr, p: &AggregateRows, count: usize) -> Vec<RowChunk> {
+    (0..a.n.div_ceil(ROWS_PER_TASK))
         .into_par_iter()
         .map(|chunk| {
             let mut acc = RowAccumulator::new(count);
@@ -673,8 +940,34 @@ fn galerkin(
             }
             out
         })
+        .collect()
+}
+
+/// The Galerkin coarse matrix `PᵀAP`, as full rows, from `ap` = `A P` in chunks of
+/// `rows_per_chunk` rows, whose rows come in blocks of `width` rows sharing their pattern
+/// in `P` and in `A P` (kept in its chunks: joining them would hold `A P` twice at the peak
+/// of the set-up).
+fn galerkin(
+    ap: Vec<RowChunk>,
+    rows_per_chunk: usize,
+    width: usize,
+    p: &AggregateRows,
+    transpose: &(Vec<usize>, Vec<(u32, u32)>),
+    numbering: &CoarseNumbering,
+) -> SymmetricCsr {
+    let count = numbering.rank.len();
+    // Where each row of AP starts in its chunk.
+    let ap_starts: Vec<Vec<usize>> = ap
+        .par_iter()
+        .map(|(lengths, _, _)| {
+            let mut starts = Vec::with_capacity(lengths.len() + 1);
+            starts.push(0);
+            for l in lengths {
+                starts.push(starts[starts.len() - 1] + l);
+            }
+            starts
+        })
         .collect();
-    let ap = concatenate(chunks);
     // Block row g of PᵀAP = Σ over fine rows i touching g of P[i, g]ᵀ · AP[i, :].
     let (start, pairs) = transpose;
     const GROUPS_PER_TASK: usize = 64;
@@ -686,11 +979,22 @@ fn galerkin(
             let mut blocks: Vec<[[Real; MODES]; MODES]> = Vec::new();
             let mut out = (Vec::new(), Vec::new(), Vec::new());
             for g in chunk * GROUPS_PER_TASK..((chunk + 1) * GROUPS_PER_TASK).min(count) {
-                for &(i, e) in &pairs[start[g]..start[g + 1]] {
-                    let pv = &p.value[e as usize];
-                    let i = i as usize;
-                    for f in ap.row_ptr[i]..ap.row_ptr[i + 1] {
-                        let h = ap.aggregate[f];
+                // The rows of one block, consecutive here, share their pattern in AP.
+                for group in pairs[start[g]..start[g + 1]].chunks(width) {
+                    // Per row of the group: its chunk of AP, where its row starts there, and
+                    // its entry of P.
+                    let mut rows = [(0usize, 0usize, 0usize); MODES];
+                    for (slot, &(i, e)) in rows.iter_mut().zip(group) {
+                        let (chunk, local) =
+                            (i as usize / rows_per_chunk, i as usize % rows_per_chunk);
+                        *slot = (chunk, ap_starts[chunk][local], e as usize);
+                    }
+                    let rows = &rows[..group.len()];
+                    let (chunk, first, _) = rows[0];
+                    let length =
+                        ap_starts[chunk][(group[0].0 as usize % rows_per_chunk) + 1] - first;
+                    let pattern = &ap[chunk].1[first..first + length];
+                    for (k, &h) in pattern.iter().enumerate() {
                         let slot = &mut place[h as usize];
                         if *slot == u32::MAX {
                             *slot = touched.len() as u32;
@@ -698,10 +1002,13 @@ fn galerkin(
                             blocks.push([[0.0; MODES]; MODES]);
                         }
                         let block = &mut blocks[*slot as usize];
-                        let av = &ap.value[f];
-                        for (row, &pt) in block.iter_mut().zip(pv) {
-                            for (x, &y) in row.iter_mut().zip(av) {
-                                *x += pt * y;
+                        for &(chunk, first, e) in rows {
+                            let av = &ap[chunk].2[first + k];
+                            debug_assert_eq!(ap[chunk].1[first + k], h);
+                            for (row, &pt) in block.iter_mut().zip(&p.value[e]) {
+                                for (x, &y) in row.iter_mut().zip(av) {
+                                    *x += pt * y;
+                                }
                             }
                         }
                     }
@@ -732,6 +1039,7 @@ fn galerkin(
         })
         .collect();
     drop(ap);
+    drop(ap_starts);
     let n: usize = numbering.rank.iter().sum();
     let nnz: usize = rows.iter().map(|c| c.1.len()).sum();
     let mut row_ptr = Vec::with_capacity(n + 1);
@@ -819,6 +1127,28 @@ mod tests {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, Real::max);
         assert!(err <= 1e-8 * scale, "{err:e} of {scale:e}");
+
+        // Built and applied on one thread, the hierarchy gives the same bits.
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let (single, one) = pool.install(|| {
+            let mut amg = SmoothedAggregation::with_coarse_size(
+                &csr,
+                &asm.groups,
+                &directions,
+                &body.nodes,
+                3,
+                200,
+            )
+            .unwrap();
+            let mut one = vec![0.0; asm.n];
+            let r = conjugate_gradient(&csr, &mut amg, &b, &mut one, CgSettings::default());
+            (r, one)
+        });
+        assert_eq!(single.iterations, report.iterations);
+        assert_eq!(one, x);
 
         let mut jacobi = BlockJacobi::new(&csr, &asm.groups).unwrap();
         let mut y = vec![0.0; asm.n];

@@ -21,8 +21,9 @@ pub struct SymmetricCsr {
     pub col: Vec<u32>,
     /// Value of each entry.
     pub val: Vec<Real>,
-    /// For each lower-triangle entry, its places in `val` (upper place = lower place on the diagonal).
-    from_lower: Vec<[u32; 2]>,
+    /// For each entry of `val`, the lower-triangle entry it copies: refilling is a gather,
+    /// every entry written once, in parallel.
+    source: Vec<u32>,
 }
 
 impl SymmetricCsr {
@@ -45,7 +46,7 @@ impl SymmetricCsr {
         let nnz = row_ptr[n];
         let mut next = count;
         let mut col = vec![0u32; nnz];
-        let mut from_lower = vec![[0u32; 2]; row_idx.len()];
+        let mut source = vec![0u32; nnz];
         // Column by column, so every row receives its columns in ascending order.
         for c in 0..n {
             for (k, &r) in row_idx[col_ptr[c]..col_ptr[c + 1]].iter().enumerate() {
@@ -53,15 +54,13 @@ impl SymmetricCsr {
                 let lower = next[r];
                 col[lower] = c as u32;
                 next[r] += 1;
-                let upper = if r != c {
+                source[lower] = e as u32;
+                if r != c {
                     let p = next[c];
                     col[p] = r as u32;
+                    source[p] = e as u32;
                     next[c] += 1;
-                    p
-                } else {
-                    lower
-                };
-                from_lower[e] = [lower as u32, upper as u32];
+                }
             }
         }
         // Row i receives its columns j < i while columns j are visited, then i and every r > i
@@ -71,7 +70,7 @@ impl SymmetricCsr {
             row_ptr,
             col,
             val: vec![0.0; nnz],
-            from_lower,
+            source,
         };
         csr.check_sorted();
         csr
@@ -85,7 +84,7 @@ impl SymmetricCsr {
             row_ptr,
             col,
             val,
-            from_lower: Vec::new(),
+            source: Vec::new(),
         };
         csr.check_sorted();
         csr
@@ -101,31 +100,37 @@ impl SymmetricCsr {
 
     /// Copy the lower-triangle values (in the assembly's order) into both triangles.
     pub fn refill(&mut self, lower_values: &[Real]) {
-        for (v, places) in lower_values.iter().zip(&self.from_lower) {
-            self.val[places[0] as usize] = *v;
-            self.val[places[1] as usize] = *v;
-        }
+        self.val
+            .par_chunks_mut(ROWS_PER_TASK * 32)
+            .zip(self.source.par_chunks(ROWS_PER_TASK * 32))
+            .for_each(|(values, sources)| {
+                for (v, &e) in values.iter_mut().zip(sources) {
+                    *v = lower_values[e as usize];
+                }
+            });
     }
 
     /// The lower-triangle values in the order they were given to [`SymmetricCsr::refill`].
     pub fn lower_values(&self, count: usize) -> Vec<Real> {
-        self.from_lower
-            .iter()
-            .take(count)
-            .map(|places| self.val[places[0] as usize])
-            .collect()
+        let mut lower = vec![0.0; count];
+        for (&v, &e) in self.val.iter().zip(&self.source) {
+            if let Some(slot) = lower.get_mut(e as usize) {
+                *slot = v;
+            }
+        }
+        lower
     }
 
     /// The diagonal entry of every row.
     pub fn diagonal(&self) -> Vec<Real> {
         (0..self.n)
+            .into_par_iter()
+            .with_min_len(ROWS_PER_TASK)
             .map(|i| {
-                let range = self.row_ptr[i]..self.row_ptr[i + 1];
-                self.col[range.clone()]
-                    .iter()
-                    .zip(&self.val[range])
-                    .find(|(c, _)| **c as usize == i)
-                    .map_or(0.0, |(_, v)| *v)
+                let start = self.row_ptr[i];
+                self.col[start..self.row_ptr[i + 1]]
+                    .binary_search(&(i as u32))
+                    .map_or(0.0, |k| self.val[start + k])
             })
             .collect()
     }
@@ -133,6 +138,27 @@ impl SymmetricCsr {
     /// `y = A x`, rows in parallel; each row is summed in a fixed order, so the result does
     /// not depend on the number of threads.
     pub fn multiply(&self, x: &[Real], y: &mut [Real]) {
+        self.for_each_row_product(x, y, |yi, ax| *yi = ax);
+    }
+
+    /// `r = b − A x` in one pass.
+    pub fn residual(&self, b: &[Real], x: &[Real], r: &mut [Real]) {
+        r.copy_from_slice(b);
+        self.subtract_product(x, r);
+    }
+
+    /// `r −= A x` in one pass.
+    pub fn subtract_product(&self, x: &[Real], r: &mut [Real]) {
+        self.for_each_row_product(x, r, |ri, ax| *ri -= ax);
+    }
+
+    /// Calls `update(y_i, (A x)_i)` for every row, rows in parallel.
+    fn for_each_row_product(
+        &self,
+        x: &[Real],
+        y: &mut [Real],
+        update: impl Fn(&mut Real, Real) + Sync,
+    ) {
         y.par_chunks_mut(ROWS_PER_TASK)
             .enumerate()
             .for_each(|(chunk, out)| {
@@ -140,14 +166,29 @@ impl SymmetricCsr {
                 for (k, yi) in out.iter_mut().enumerate() {
                     let i = first + k;
                     let range = self.row_ptr[i]..self.row_ptr[i + 1];
-                    *yi = self.col[range.clone()]
-                        .iter()
-                        .zip(&self.val[range])
-                        .map(|(&c, &v)| v * x[c as usize])
-                        .sum();
+                    update(yi, row_times(&self.col[range.clone()], &self.val[range], x));
                 }
             });
     }
+}
+
+/// `Σ val_k x[col_k]` with four interleaved partial sums (a single chain of additions would
+/// bound the product by the adder's latency, not by memory), combined in a fixed order.
+#[inline(always)]
+fn row_times(col: &[u32], val: &[Real], x: &[Real]) -> Real {
+    let mut acc = [0.0; 4];
+    let mut cols = col.chunks_exact(4);
+    let mut vals = val.chunks_exact(4);
+    for (c, v) in (&mut cols).zip(&mut vals) {
+        for k in 0..4 {
+            acc[k] += v[k] * x[c[k] as usize];
+        }
+    }
+    let mut sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (&c, &v) in cols.remainder().iter().zip(vals.remainder()) {
+        sum += v * x[c as usize];
+    }
+    sum
 }
 
 /// An approximate inverse of a symmetric positive definite matrix, applied once per
@@ -182,6 +223,11 @@ mod tests {
         assert_eq!(a.row_ptr, vec![0, 2, 5, 7]);
         assert_eq!(a.col, vec![0, 1, 0, 1, 2, 1, 2]);
         assert_eq!(a.diagonal(), vec![4.0, 5.0, 6.0]);
+        assert_eq!(a.val, vec![4.0, 1.0, 1.0, 5.0, 2.0, 2.0, 6.0]);
+        assert_eq!(a.lower_values(5), vec![4.0, 1.0, 5.0, 2.0, 6.0]);
+        let mut r = vec![0.0; 3];
+        a.residual(&[10.0, 20.0, 30.0], &[1.0, 2.0, 3.0], &mut r);
+        assert_eq!(r, vec![4.0, 3.0, 8.0]);
         let mut y = vec![0.0; 3];
         a.multiply(&[1.0, 2.0, 3.0], &mut y);
         assert_eq!(y, vec![6.0, 17.0, 22.0]);
