@@ -461,18 +461,37 @@ fn large_displacement_disk_on_floor_balances() {
     }
 }
 
-/// A unit cube given as an OBJ triangle mesh (counter-clockwise seen from outside) acts exactly
-/// like the same cube as a cuboid obstacle: a 3D box pressed onto it gets the same contacts and
-/// displacements (to 1e-9 of the largest).
-#[test]
-fn mesh_obstacle_matches_the_cuboid() {
-    let cube_obj = "\
+/// A unit cube as OBJ text: faces counter-clockwise seen from outside.
+const CUBE_OBJ: &str = "\
 v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n\
 v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
 f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
-    let scene = |obstacle: &str| {
-        format!(
-            r#"
+
+/// The cube of `CUBE_OBJ` as triangles (corners in m), each quad fanned as OBJ does.
+fn cube_triangles() -> Vec<[[f32; 3]; 3]> {
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for line in CUBE_OBJ.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => vertices.push([0, 1, 2].map(|_| words.next().unwrap().parse().unwrap())),
+            Some("f") => {
+                let f: Vec<usize> = words.map(|w| w.parse::<usize>().unwrap() - 1).collect();
+                for j in 1..f.len() - 1 {
+                    triangles.push([vertices[f[0]], vertices[f[j]], vertices[f[j + 1]]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    triangles
+}
+
+/// A 3D box lattice pressed 2 mm down by its top face onto the obstacle `obstacle` (its TOML
+/// keys), a unit cube below it.
+fn box_on_cube(obstacle: &str) -> String {
+    format!(
+        r#"
 name = "box_on_cube"
 steps = 2
 [[materials]]
@@ -491,20 +510,12 @@ displacement = [0.0, -0.002, 0.0]
 name = "cube"
 {obstacle}
 "#
-        )
-    };
-    let (_dir, mesh_path) = scene_with(
-        &[("cube.obj", cube_obj)],
-        &scene("shape = \"mesh\"\nfile = \"cube.obj\""),
-    );
-    let with_mesh = run_all(&load_scene(&mesh_path).unwrap());
-    let cuboid = build_world(
-        &scene("shape = \"cuboid\"\ncenter = [0.0, 0.0, 0.0]\nhalf_extents = [0.5, 0.5, 0.5]"),
-        Path::new("box_on_cube.toml"),
     )
-    .unwrap();
-    let with_cuboid = run_all(&cuboid);
-    let (a, b) = (&with_mesh[2].0.bodies[0], &with_cuboid[2].0.bodies[0]);
+}
+
+/// Whether two runs' last steps have the same contacts (nodes, depths and forces) and
+/// displacements, to `tolerance` of the largest.
+fn same_answer(a: &linkage::scene::BodyResult, b: &linkage::scene::BodyResult, tolerance: f64) {
     assert_eq!(a.contacts.len(), 9, "the bottom face's 3 × 3 nodes");
     assert_eq!(a.contacts.len(), b.contacts.len());
     let largest = b
@@ -518,7 +529,92 @@ name = "cube"
         .flatten()
         .zip(b.displacements.iter().flatten())
     {
-        assert!((u - v).abs() <= 1e-9 * largest);
+        assert!((u - v).abs() <= tolerance * largest);
+    }
+    let force = b.contacts.iter().map(|c| c.force[1]).fold(0.0, f64::max);
+    for (c, d) in a.contacts.iter().zip(&b.contacts) {
+        assert_eq!((c.node, &c.with), (d.node, &d.with));
+        assert!((c.depth - d.depth).abs() <= tolerance * largest);
+        for k in 0..3 {
+            assert!((c.force[k] - d.force[k]).abs() <= tolerance * force);
+        }
+    }
+}
+
+/// A unit cube given as an OBJ triangle mesh (counter-clockwise seen from outside) acts exactly
+/// like the same cube as a cuboid obstacle: a 3D box pressed onto it gets the same contacts and
+/// displacements (to 1e-9 of the largest).
+#[test]
+fn mesh_obstacle_matches_the_cuboid() {
+    let (_dir, mesh_path) = scene_with(
+        &[("cube.obj", CUBE_OBJ)],
+        &box_on_cube("shape = \"mesh\"\nfile = \"cube.obj\""),
+    );
+    let with_mesh = run_all(&load_scene(&mesh_path).unwrap());
+    let cuboid = build_world(
+        &box_on_cube(
+            "shape = \"cuboid\"\ncenter = [0.0, 0.0, 0.0]\nhalf_extents = [0.5, 0.5, 0.5]",
+        ),
+        Path::new("box_on_cube.toml"),
+    )
+    .unwrap();
+    let with_cuboid = run_all(&cuboid);
+    same_answer(&with_mesh[2].0.bodies[0], &with_cuboid[2].0.bodies[0], 1e-9);
+}
+
+/// The cube as a binary STL (whose 80-byte header begins with `solid`, as many exporters write
+/// it: the file's size tells it from ASCII) gives the same answer as the cube as an ASCII STL:
+/// the same 9 contacts, depths, forces and displacements (to 1e-12 of the largest: the corners
+/// are the same numbers, ±0.5, in f32 and in text). A binary file cut short is reported with
+/// the triangle cut and both sizes.
+#[test]
+fn binary_stl_mesh_matches_the_ascii_one() {
+    let triangles = cube_triangles();
+    assert_eq!(triangles.len(), 12);
+    let mut ascii = String::from("solid cube\n");
+    let mut binary = b"solid cube, binary".to_vec();
+    binary.resize(80, 0);
+    binary.extend((triangles.len() as u32).to_le_bytes());
+    for t in &triangles {
+        ascii.push_str("  facet normal 0 0 0\n    outer loop\n");
+        binary.extend([0u8; 12]);
+        for c in t {
+            ascii.push_str(&format!("      vertex {} {} {}\n", c[0], c[1], c[2]));
+            for x in c {
+                binary.extend(x.to_le_bytes());
+            }
+        }
+        binary.extend([0u8; 2]);
+        ascii.push_str("    endloop\n  endfacet\n");
+    }
+    ascii.push_str("endsolid cube\n");
+    assert_eq!(binary.len(), 84 + 50 * 12);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ascii.stl"), &ascii).unwrap();
+    std::fs::write(dir.path().join("binary.stl"), &binary).unwrap();
+    std::fs::write(dir.path().join("cut.stl"), &binary[..84 + 50 * 7 + 30]).unwrap();
+    let run = |file: &str| {
+        let path = dir.path().join(format!("{file}.toml"));
+        let text = box_on_cube(&format!("shape = \"mesh\"\nfile = \"{file}.stl\""));
+        std::fs::write(&path, text).unwrap();
+        load_scene(&path).map(|w| run_all(&w))
+    };
+    let from_ascii = run("ascii").unwrap();
+    let from_binary = run("binary").unwrap();
+    same_answer(
+        &from_binary[2].0.bodies[0],
+        &from_ascii[2].0.bodies[0],
+        1e-12,
+    );
+    let err = run("cut").map(|_| ()).unwrap_err().to_string();
+    for part in [
+        "cut.stl",
+        "12 triangles",
+        "684 bytes",
+        "464 bytes",
+        "triangle 8",
+    ] {
+        assert!(err.contains(part), "{part:?} in {err}");
     }
 }
 
