@@ -721,3 +721,171 @@ fn condensed_and_coupled_solves_agree_on_the_bundled_scenes() {
         }
     }
 }
+
+/// A flat square plate, 1 m × 1 m in the x-z plane at y = 0, whose contact surface is one
+/// layer of patches (an open shell, facing +y): 4 × 4 cells of 0.25 m, stiffened by a second
+/// layer of nodes at y = `stiffener` (every pair of corners of a cell joined, as in a box
+/// lattice), so that it carries a force across its plane. Its files (nodes, links, patches).
+fn plate_files(stiffener: f64) -> (String, String, String) {
+    let n = 5;
+    let index = |i: usize, j: usize, layer: usize| layer * n * n + j * n + i + 1;
+    let mut nodes = String::new();
+    for (layer, y) in [0.0, stiffener].into_iter().enumerate() {
+        let _ = layer;
+        for j in 0..n {
+            for i in 0..n {
+                nodes.push_str(&format!("{} {y} {}\n", 0.25 * i as f64, 0.25 * j as f64));
+            }
+        }
+    }
+    let mut links = std::collections::BTreeSet::new();
+    let mut patches = String::new();
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let corners: Vec<usize> = (0..8)
+                .map(|k| index(i + (k & 1), j + ((k >> 1) & 1), k >> 2))
+                .collect();
+            for a in 0..8 {
+                for b in a + 1..8 {
+                    links.insert((corners[a], corners[b]));
+                }
+            }
+            // Counter-clockwise seen from +y (x right, z toward the viewer: x, then -z).
+            let (p00, p10, p01, p11) = (
+                index(i, j, 0),
+                index(i + 1, j, 0),
+                index(i, j + 1, 0),
+                index(i + 1, j + 1, 0),
+            );
+            patches.push_str(&format!("{p00} {p11} {p10}\n{p00} {p01} {p11}\n"));
+        }
+    }
+    let links = links.iter().map(|(a, b)| format!("{a} {b}\n")).collect();
+    (nodes, links, patches)
+}
+
+/// A plate (see `plate_files`) fixed at its rim, and a small 3D box (0.18 × 0.1 × 0.18 m)
+/// starting 1 mm from its patches on the side `side` (+1 above, −1 below, the plate's
+/// stiffening layer on the other side), held sideways and pushed toward the plate by a total
+/// force F = 1000 N: held by contact alone. Its nodes are placed off the plate's patch edges (a
+/// node on an edge between two patches may flip between them, see `stack.toml`), and no plate
+/// node lies under it (which would press on the box's own closed surface and hold it: only the
+/// shell can).
+fn box_on_shell(side: f64) -> String {
+    let (box_y, face_y) = if side > 0.0 {
+        (0.001, 0.101)
+    } else {
+        (-0.101, -0.101)
+    };
+    format!(
+        r#"
+name = "box_on_shell"
+steps = 2
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "plate"
+nodes = "plate.nodes"
+links = "plate.links"
+patches = "plate.patches"
+material = "steel"
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }}
+fix = ["x", "y", "z"]
+[[bodies.supports]]
+on_plane = {{ point = [1.0, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }}
+fix = ["x", "y", "z"]
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0] }}
+fix = ["x", "y", "z"]
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0, 1.0], normal = [0.0, 0.0, 1.0] }}
+fix = ["x", "y", "z"]
+[[bodies]]
+name = "box"
+box_lattice = {{ size = [0.18, 0.1, 0.18], cells = [2, 1, 2] }}
+offset = [0.54, {box_y}, 0.28]
+material = "steel"
+[[bodies.supports]]
+inside = {{ min = [-1.0, -1.0, -1.0], max = [2.0, 2.0, 2.0] }}
+fix = ["x", "z"]
+[[bodies.loads]]
+on_plane = {{ point = [0.0, {face_y}, 0.0], normal = [0.0, 1.0, 0.0] }}
+total_force = [0.0, {force}, 0.0]
+[contact]
+"#,
+        force = -1000.0 * side,
+    )
+}
+
+/// Open shells are two-sided contact targets. A box pushed onto a flat open shell (one layer of
+/// patches facing +y) from above, and the same from below with the force reversed (the nodes
+/// then cross the patches from behind): both on the condensed path (linear bodies factored
+/// once) and the coupled one. At each step (F/2, F): the plate receives F from the box (1e-6
+/// relative) and the box minus that (1e-9), reactions, loads and contact forces balance (1e-8
+/// of the largest), and every box node stays on the side it started on (no node farther
+/// across the patches than the penetration tolerance, 1% of the box's mean member length).
+/// Without the shell as a target the box, held by nothing else, would fly through it.
+#[test]
+fn box_pressed_on_an_open_shell_from_either_side_is_held() {
+    for side in [1.0, -1.0] {
+        let (nodes, links, patches) = plate_files(-0.1 * side);
+        let (_dir, path) = scene_with(
+            &[
+                ("plate.nodes", &nodes),
+                ("plate.links", &links),
+                ("plate.patches", &patches),
+            ],
+            &box_on_shell(side),
+        );
+        let mut world = load_scene(&path).unwrap();
+        let tolerance = linkage::contact::penetration_tolerance(&world.bodies[1]);
+        for condense in [true, false] {
+            world.contact.condense = condense;
+            let runs = run_all(&world);
+            let start = &runs[0].0.bodies[1];
+            for (result, summary) in runs.iter().skip(1) {
+                let what = format!("side {side}, condense {condense}, step {}", result.step);
+                let load = 1000.0 * result.load_factor;
+                let total = |body: &str, with: &str| -> Vec<f64> {
+                    summary
+                        .contact_forces
+                        .iter()
+                        .find(|p| p.body == body && p.with == with)
+                        .unwrap_or_else(|| panic!("{what}: {:?}", summary.contact_forces))
+                        .force
+                        .clone()
+                };
+                let (on_plate, on_box) = (total("plate", "box"), total("box", "plate"));
+                assert!(
+                    (on_plate[1] + side * load).abs() <= 1e-6 * load,
+                    "{what}: {on_plate:?}"
+                );
+                for k in 0..3 {
+                    assert!((on_plate[k] + on_box[k]).abs() <= 1e-9 * load, "{what}");
+                }
+                let (sum, largest) = balance(result);
+                for s in sum {
+                    assert!(s.abs() <= 1e-8 * largest, "{what}: {sum:?}");
+                }
+                let moved = &result.bodies[1];
+                for (x0, x) in start.positions.iter().zip(&moved.positions) {
+                    assert!(x0[1] * side > 0.0, "{what}: starts off the shell");
+                    assert!(x[1] * side > -tolerance, "{what}: {x:?} crossed the shell");
+                }
+                assert!(
+                    summary.max_penetration > 0.0 && summary.max_penetration <= tolerance,
+                    "{what}: {}",
+                    summary.max_penetration
+                );
+                assert!(
+                    summary.warnings.is_empty(),
+                    "{what}: {:?}",
+                    summary.warnings
+                );
+            }
+        }
+    }
+}
