@@ -461,18 +461,37 @@ fn large_displacement_disk_on_floor_balances() {
     }
 }
 
-/// A unit cube given as an OBJ triangle mesh (counter-clockwise seen from outside) acts exactly
-/// like the same cube as a cuboid obstacle: a 3D box pressed onto it gets the same contacts and
-/// displacements (to 1e-9 of the largest).
-#[test]
-fn mesh_obstacle_matches_the_cuboid() {
-    let cube_obj = "\
+/// A unit cube as OBJ text: faces counter-clockwise seen from outside.
+const CUBE_OBJ: &str = "\
 v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n\
 v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
 f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
-    let scene = |obstacle: &str| {
-        format!(
-            r#"
+
+/// The cube of `CUBE_OBJ` as triangles (corners in m), each quad fanned as OBJ does.
+fn cube_triangles() -> Vec<[[f32; 3]; 3]> {
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for line in CUBE_OBJ.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => vertices.push([0, 1, 2].map(|_| words.next().unwrap().parse().unwrap())),
+            Some("f") => {
+                let f: Vec<usize> = words.map(|w| w.parse::<usize>().unwrap() - 1).collect();
+                for j in 1..f.len() - 1 {
+                    triangles.push([vertices[f[0]], vertices[f[j]], vertices[f[j + 1]]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    triangles
+}
+
+/// A 3D box lattice pressed 2 mm down by its top face onto the obstacle `obstacle` (its TOML
+/// keys), a unit cube below it.
+fn box_on_cube(obstacle: &str) -> String {
+    format!(
+        r#"
 name = "box_on_cube"
 steps = 2
 [[materials]]
@@ -491,20 +510,12 @@ displacement = [0.0, -0.002, 0.0]
 name = "cube"
 {obstacle}
 "#
-        )
-    };
-    let (_dir, mesh_path) = scene_with(
-        &[("cube.obj", cube_obj)],
-        &scene("shape = \"mesh\"\nfile = \"cube.obj\""),
-    );
-    let with_mesh = run_all(&load_scene(&mesh_path).unwrap());
-    let cuboid = build_world(
-        &scene("shape = \"cuboid\"\ncenter = [0.0, 0.0, 0.0]\nhalf_extents = [0.5, 0.5, 0.5]"),
-        Path::new("box_on_cube.toml"),
     )
-    .unwrap();
-    let with_cuboid = run_all(&cuboid);
-    let (a, b) = (&with_mesh[2].0.bodies[0], &with_cuboid[2].0.bodies[0]);
+}
+
+/// Whether two runs' last steps have the same contacts (nodes, depths and forces) and
+/// displacements, to `tolerance` of the largest.
+fn same_answer(a: &linkage::scene::BodyResult, b: &linkage::scene::BodyResult, tolerance: f64) {
     assert_eq!(a.contacts.len(), 9, "the bottom face's 3 × 3 nodes");
     assert_eq!(a.contacts.len(), b.contacts.len());
     let largest = b
@@ -518,7 +529,92 @@ name = "cube"
         .flatten()
         .zip(b.displacements.iter().flatten())
     {
-        assert!((u - v).abs() <= 1e-9 * largest);
+        assert!((u - v).abs() <= tolerance * largest);
+    }
+    let force = b.contacts.iter().map(|c| c.force[1]).fold(0.0, f64::max);
+    for (c, d) in a.contacts.iter().zip(&b.contacts) {
+        assert_eq!((c.node, &c.with), (d.node, &d.with));
+        assert!((c.depth - d.depth).abs() <= tolerance * largest);
+        for k in 0..3 {
+            assert!((c.force[k] - d.force[k]).abs() <= tolerance * force);
+        }
+    }
+}
+
+/// A unit cube given as an OBJ triangle mesh (counter-clockwise seen from outside) acts exactly
+/// like the same cube as a cuboid obstacle: a 3D box pressed onto it gets the same contacts and
+/// displacements (to 1e-9 of the largest).
+#[test]
+fn mesh_obstacle_matches_the_cuboid() {
+    let (_dir, mesh_path) = scene_with(
+        &[("cube.obj", CUBE_OBJ)],
+        &box_on_cube("shape = \"mesh\"\nfile = \"cube.obj\""),
+    );
+    let with_mesh = run_all(&load_scene(&mesh_path).unwrap());
+    let cuboid = build_world(
+        &box_on_cube(
+            "shape = \"cuboid\"\ncenter = [0.0, 0.0, 0.0]\nhalf_extents = [0.5, 0.5, 0.5]",
+        ),
+        Path::new("box_on_cube.toml"),
+    )
+    .unwrap();
+    let with_cuboid = run_all(&cuboid);
+    same_answer(&with_mesh[2].0.bodies[0], &with_cuboid[2].0.bodies[0], 1e-9);
+}
+
+/// The cube as a binary STL (whose 80-byte header begins with `solid`, as many exporters write
+/// it: the file's size tells it from ASCII) gives the same answer as the cube as an ASCII STL:
+/// the same 9 contacts, depths, forces and displacements (to 1e-12 of the largest: the corners
+/// are the same numbers, ±0.5, in f32 and in text). A binary file cut short is reported with
+/// the triangle cut and both sizes.
+#[test]
+fn binary_stl_mesh_matches_the_ascii_one() {
+    let triangles = cube_triangles();
+    assert_eq!(triangles.len(), 12);
+    let mut ascii = String::from("solid cube\n");
+    let mut binary = b"solid cube, binary".to_vec();
+    binary.resize(80, 0);
+    binary.extend((triangles.len() as u32).to_le_bytes());
+    for t in &triangles {
+        ascii.push_str("  facet normal 0 0 0\n    outer loop\n");
+        binary.extend([0u8; 12]);
+        for c in t {
+            ascii.push_str(&format!("      vertex {} {} {}\n", c[0], c[1], c[2]));
+            for x in c {
+                binary.extend(x.to_le_bytes());
+            }
+        }
+        binary.extend([0u8; 2]);
+        ascii.push_str("    endloop\n  endfacet\n");
+    }
+    ascii.push_str("endsolid cube\n");
+    assert_eq!(binary.len(), 84 + 50 * 12);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("ascii.stl"), &ascii).unwrap();
+    std::fs::write(dir.path().join("binary.stl"), &binary).unwrap();
+    std::fs::write(dir.path().join("cut.stl"), &binary[..84 + 50 * 7 + 30]).unwrap();
+    let run = |file: &str| {
+        let path = dir.path().join(format!("{file}.toml"));
+        let text = box_on_cube(&format!("shape = \"mesh\"\nfile = \"{file}.stl\""));
+        std::fs::write(&path, text).unwrap();
+        load_scene(&path).map(|w| run_all(&w))
+    };
+    let from_ascii = run("ascii").unwrap();
+    let from_binary = run("binary").unwrap();
+    same_answer(
+        &from_binary[2].0.bodies[0],
+        &from_ascii[2].0.bodies[0],
+        1e-12,
+    );
+    let err = run("cut").map(|_| ()).unwrap_err().to_string();
+    for part in [
+        "cut.stl",
+        "12 triangles",
+        "684 bytes",
+        "464 bytes",
+        "triangle 8",
+    ] {
+        assert!(err.contains(part), "{part:?} in {err}");
     }
 }
 
@@ -623,6 +719,179 @@ fn condensed_and_coupled_solves_agree_on_the_bundled_scenes() {
                     c.iter().map(|c| c.node).collect()
                 };
                 assert_eq!(nodes(&ba.contacts), nodes(&bb.contacts), "{scene}");
+            }
+        }
+    }
+}
+
+/// A flat square plate, 1 m × 1 m in the x-z plane at y = 0, whose contact surface is one
+/// layer of patches (an open shell, facing +y): 4 × 4 cells of 0.25 m, stiffened by a second
+/// layer of nodes at y = `stiffener` (every pair of corners of a cell joined, as in a box
+/// lattice), so that it carries a force across its plane. Its files (nodes, links, patches).
+fn plate_files(stiffener: f64) -> (String, String, String) {
+    let n = 5;
+    let index = |i: usize, j: usize, layer: usize| layer * n * n + j * n + i + 1;
+    let mut nodes = String::new();
+    for (layer, y) in [0.0, stiffener].into_iter().enumerate() {
+        let _ = layer;
+        for j in 0..n {
+            for i in 0..n {
+                nodes.push_str(&format!("{} {y} {}\n", 0.25 * i as f64, 0.25 * j as f64));
+            }
+        }
+    }
+    let mut links = std::collections::BTreeSet::new();
+    let mut patches = String::new();
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let corners: Vec<usize> = (0..8)
+                .map(|k| index(i + (k & 1), j + ((k >> 1) & 1), k >> 2))
+                .collect();
+            for a in 0..8 {
+                for b in a + 1..8 {
+                    links.insert((corners[a], corners[b]));
+                }
+            }
+            // Counter-clockwise seen from +y (x right, z toward the viewer: x, then -z).
+            let (p00, p10, p01, p11) = (
+                index(i, j, 0),
+                index(i + 1, j, 0),
+                index(i, j + 1, 0),
+                index(i + 1, j + 1, 0),
+            );
+            patches.push_str(&format!("{p00} {p11} {p10}\n{p00} {p01} {p11}\n"));
+        }
+    }
+    let links = links.iter().map(|(a, b)| format!("{a} {b}\n")).collect();
+    (nodes, links, patches)
+}
+
+/// A plate (see `plate_files`) fixed at its rim, and a small 3D box (0.18 × 0.1 × 0.18 m)
+/// starting `gap` (m) from its patches on the side `side` (+1 above, −1 below, the plate's
+/// stiffening layer on the other side), held sideways and pushed toward the plate by a total
+/// force F = 1000 N: held by contact alone. Its nodes are placed off the plate's patch edges (a
+/// node on an edge between two patches may flip between them, see `stack.toml`), and no plate
+/// node lies under it (which would press on the box's own closed surface and hold it: only the
+/// shell can).
+fn box_on_shell(side: f64, gap: f64) -> String {
+    let (box_y, face_y) = if side > 0.0 {
+        (gap, gap + 0.1)
+    } else {
+        (-0.1 - gap, -0.1 - gap)
+    };
+    format!(
+        r#"
+name = "box_on_shell"
+steps = 2
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "plate"
+nodes = "plate.nodes"
+links = "plate.links"
+patches = "plate.patches"
+material = "steel"
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }}
+fix = ["x", "y", "z"]
+[[bodies.supports]]
+on_plane = {{ point = [1.0, 0.0, 0.0], normal = [1.0, 0.0, 0.0] }}
+fix = ["x", "y", "z"]
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0] }}
+fix = ["x", "y", "z"]
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0, 1.0], normal = [0.0, 0.0, 1.0] }}
+fix = ["x", "y", "z"]
+[[bodies]]
+name = "box"
+box_lattice = {{ size = [0.18, 0.1, 0.18], cells = [2, 1, 2] }}
+offset = [0.54, {box_y}, 0.28]
+material = "steel"
+[[bodies.supports]]
+inside = {{ min = [-1.0, -1.0, -1.0], max = [2.0, 2.0, 2.0] }}
+fix = ["x", "z"]
+[[bodies.loads]]
+on_plane = {{ point = [0.0, {face_y}, 0.0], normal = [0.0, 1.0, 0.0] }}
+total_force = [0.0, {force}, 0.0]
+[contact]
+"#,
+        force = -1000.0 * side,
+    )
+}
+
+/// Open shells are two-sided contact targets. A box pushed onto a flat open shell (one layer of
+/// patches facing +y) from above, and the same from below with the force reversed (the nodes
+/// then cross the patches from behind): both on the condensed path (linear bodies factored
+/// once) and the coupled one. At each step (F/2, F): the plate receives F from the box (1e-6
+/// relative) and the box minus that (1e-9), reactions, loads and contact forces balance (1e-8
+/// of the largest), and every box node stays on the side it started on (no node farther
+/// across the patches than the penetration tolerance, 1% of the box's mean member length).
+/// Without the shell as a target the box, held by nothing else, would fly through it. The box
+/// starts 1 mm from the shell, or resting on it (its face's nodes on the patches take the side
+/// of the box's other nodes).
+#[test]
+fn box_pressed_on_an_open_shell_from_either_side_is_held() {
+    for (side, gap) in [(1.0, 1e-3), (-1.0, 1e-3), (1.0, 0.0), (-1.0, 0.0)] {
+        let (nodes, links, patches) = plate_files(-0.1 * side);
+        let (_dir, path) = scene_with(
+            &[
+                ("plate.nodes", &nodes),
+                ("plate.links", &links),
+                ("plate.patches", &patches),
+            ],
+            &box_on_shell(side, gap),
+        );
+        let mut world = load_scene(&path).unwrap();
+        let tolerance = linkage::contact::penetration_tolerance(&world.bodies[1]);
+        for condense in [true, false] {
+            world.contact.condense = condense;
+            let runs = run_all(&world);
+            let start = &runs[0].0.bodies[1];
+            for (result, summary) in runs.iter().skip(1) {
+                let what = format!(
+                    "side {side}, gap {gap}, condense {condense}, step {}",
+                    result.step
+                );
+                let load = 1000.0 * result.load_factor;
+                let total = |body: &str, with: &str| -> Vec<f64> {
+                    summary
+                        .contact_forces
+                        .iter()
+                        .find(|p| p.body == body && p.with == with)
+                        .unwrap_or_else(|| panic!("{what}: {:?}", summary.contact_forces))
+                        .force
+                        .clone()
+                };
+                let (on_plate, on_box) = (total("plate", "box"), total("box", "plate"));
+                assert!(
+                    (on_plate[1] + side * load).abs() <= 1e-6 * load,
+                    "{what}: {on_plate:?}"
+                );
+                for k in 0..3 {
+                    assert!((on_plate[k] + on_box[k]).abs() <= 1e-9 * load, "{what}");
+                }
+                let (sum, largest) = balance(result);
+                for s in sum {
+                    assert!(s.abs() <= 1e-8 * largest, "{what}: {sum:?}");
+                }
+                let moved = &result.bodies[1];
+                for (x0, x) in start.positions.iter().zip(&moved.positions) {
+                    assert!(x0[1] * side >= 0.0, "{what}: starts on its side");
+                    assert!(x[1] * side > -tolerance, "{what}: {x:?} crossed the shell");
+                }
+                assert!(
+                    summary.max_penetration > 0.0 && summary.max_penetration <= tolerance,
+                    "{what}: {}",
+                    summary.max_penetration
+                );
+                assert!(
+                    summary.warnings.is_empty(),
+                    "{what}: {:?}",
+                    summary.warnings
+                );
             }
         }
     }

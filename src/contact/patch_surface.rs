@@ -1,5 +1,5 @@
-//! The contact surface of a 3D body: its patches as an oriented parry `TriMesh`, rebuilt from the
-//! deformed nodes at every query.
+//! The contact surface of a 3D body: its patches as a parry `TriMesh` (oriented for a closed
+//! surface, two-sided for an open shell), rebuilt from the deformed nodes at every query.
 
 use crate::linkage::Body;
 use crate::Real;
@@ -8,14 +8,36 @@ use rapier3d_f64::math::Vector;
 use rapier3d_f64::parry::query::PointQueryWithLocation;
 use rapier3d_f64::parry::shape::{TriMesh, TriMeshFlags};
 
-/// A 3D body's closed surface, every patch facing out.
+/// A 3D body's contact surface: a closed surface, every patch facing out, or an open shell
+/// (two-sided: a node is pushed back to the side it came from).
 pub struct PatchSurface {
-    /// The patches, as body node indices, counter-clockwise seen from outside.
+    /// The patches, as body node indices, counter-clockwise seen from outside (an open
+    /// shell: as given, all turning the same way).
     pub patches: Vec<[usize; 3]>,
     /// The body nodes the patches use (mesh vertex i is body node `nodes[i]`).
     pub nodes: Vec<usize>,
     /// Whether the patches had to be turned round to face out.
     pub flipped: bool,
+    /// Open shell only: per patch, whether its edges a→b, b→c, c→a are on the shell's rim
+    /// (edges of one patch only). Empty for a closed surface.
+    pub rim_edges: Vec<[bool; 3]>,
+    /// Open shell only: per patch, whether its corners a, b, c are on the rim.
+    pub rim_corners: Vec<[bool; 3]>,
+}
+
+/// Where a point lies against an open shell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShellSide {
+    /// The patch of the nearest point.
+    pub patch: usize,
+    /// Distance to the shell, m.
+    pub distance: Real,
+    /// +1 in front of that patch (along its normal, `a b c` counter-clockwise seen from there),
+    /// −1 behind it, 0 on it.
+    pub side: Real,
+    /// Whether the nearest point is on the shell's rim (the point is beside the shell, not
+    /// in front of or behind it).
+    pub on_rim: bool,
 }
 
 /// Why a body's patches cannot be a contact surface.
@@ -70,7 +92,110 @@ impl PatchSurface {
             patches,
             nodes,
             flipped,
+            rim_edges: Vec::new(),
+            rim_corners: Vec::new(),
         }))
+    }
+
+    /// The patches of `body` as an open shell (two-sided), `None` without patches. Call it when
+    /// [`PatchSurface::of`] finds the surface not closed: the patches must still turn the same
+    /// way across every shared edge (so that "in front" means one side of the whole shell).
+    pub fn open_shell(body: &Body) -> Option<Self> {
+        if body.patches.is_empty() {
+            return None;
+        }
+        let mut undirected: Vec<(usize, usize)> = body
+            .patches
+            .iter()
+            .flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)])
+            .map(|(a, b)| (a.min(b), a.max(b)))
+            .collect();
+        undirected.sort_unstable();
+        let once = |a: usize, b: usize| {
+            let e = (a.min(b), a.max(b));
+            let first = undirected.partition_point(|x| *x < e);
+            undirected.get(first + 1) != Some(&e)
+        };
+        let rim_edges: Vec<[bool; 3]> = body
+            .patches
+            .iter()
+            .map(|&[a, b, c]| [once(a, b), once(b, c), once(c, a)])
+            .collect();
+        let mut rim_node = vec![false; body.nodes.len()];
+        for (patch, edges) in body.patches.iter().zip(&rim_edges) {
+            for i in (0..3).filter(|&i| edges[i]) {
+                rim_node[patch[i]] = true;
+                rim_node[patch[(i + 1) % 3]] = true;
+            }
+        }
+        let rim_corners = body
+            .patches
+            .iter()
+            .map(|p| p.map(|n| rim_node[n]))
+            .collect();
+        let mut nodes: Vec<usize> = body.patches.iter().flatten().copied().collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        Some(PatchSurface {
+            patches: body.patches.clone(),
+            nodes,
+            flipped: false,
+            rim_edges,
+            rim_corners,
+        })
+    }
+
+    /// Whether this is an open shell (a two-sided target).
+    pub fn is_open(&self) -> bool {
+        !self.rim_edges.is_empty()
+    }
+
+    /// Where `x` (m) lies against the open shell `mesh` (made by [`PatchSurface::mesh`] at the
+    /// positions `position(node)`): the nearest patch, the distance and the side.
+    pub fn shell_side(
+        &self,
+        mesh: &TriMesh,
+        x: &Vector3<Real>,
+        position: impl Fn(usize) -> Vector3<Real>,
+    ) -> ShellSide {
+        let (projection, (patch, _)) =
+            mesh.project_local_point_and_get_location(Vector::new(x.x, x.y, x.z), false);
+        let patch = patch as usize;
+        let p = Vector3::new(projection.point.x, projection.point.y, projection.point.z);
+        let distance = (x - p).norm();
+        let [a, b, c] = self.patches[patch].map(&position);
+        let normal = (b - a).cross(&(c - a));
+        let along = (x - p).dot(&normal);
+        let side = if distance == 0.0 || along == 0.0 {
+            0.0
+        } else {
+            along.signum()
+        };
+        // The nearest point on a rim corner or a rim edge of the patch, and the point not
+        // straight in front of or behind it: beside the shell.
+        let corners = [a, b, c];
+        let edges = self.rim_edges.get(patch).copied().unwrap_or([false; 3]);
+        let rim_corners = self.rim_corners.get(patch).copied().unwrap_or([false; 3]);
+        let near = 1e-9 * (b - a).norm().max((c - a).norm());
+        let on_rim_point = (0..3).any(|i| {
+            (rim_corners[i] && (p - corners[i]).norm() <= near)
+                || (edges[i] && segment_distance(&p, &corners[i], &corners[(i + 1) % 3]) <= near)
+        });
+        let normal_length = normal.norm();
+        let sideways = if normal_length > 0.0 {
+            let n = normal / normal_length;
+            let d = x - p;
+            (d - n * d.dot(&n)).norm()
+        } else {
+            0.0
+        };
+        let on_rim = on_rim_point && sideways > 1e-6 * distance;
+        ShellSide {
+            patch,
+            distance,
+            side,
+            on_rim,
+        }
     }
 
     /// The oriented mesh at the positions `position(node)` (m), and its bounding box.
@@ -92,7 +217,12 @@ impl PatchSurface {
             .iter()
             .map(|&[a, b, c]| [index(a), index(b), index(c)])
             .collect();
-        let mesh = TriMesh::with_flags(vertices, indices, TriMeshFlags::ORIENTED).ok()?;
+        let flags = if self.is_open() {
+            TriMeshFlags::empty()
+        } else {
+            TriMeshFlags::ORIENTED
+        };
+        let mesh = TriMesh::with_flags(vertices, indices, flags).ok()?;
         Some((mesh, [lo, hi]))
     }
 
@@ -107,6 +237,18 @@ impl PatchSurface {
         let distance = (Vector3::new(p.x, p.y, p.z) - x).norm();
         Some((patch as usize, distance))
     }
+}
+
+/// Distance from `p` to the segment `a b`, m.
+fn segment_distance(p: &Vector3<Real>, a: &Vector3<Real>, b: &Vector3<Real>) -> Real {
+    let ab = b - a;
+    let length2 = ab.norm_squared();
+    let t = if length2 > 0.0 {
+        ((p - a).dot(&ab) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * t)).norm()
 }
 
 /// A point against a triangle `a b c` (counter-clockwise seen from outside).
@@ -178,6 +320,51 @@ mod tests {
         let mut inverted = body.clone();
         inverted.patches.iter_mut().for_each(|p| p.swap(1, 2));
         assert!(PatchSurface::of(&inverted).unwrap().unwrap().flipped);
+    }
+
+    /// A unit square in z = 0 of two patches facing +z, as an open shell: its four outer edges
+    /// are the rim, the diagonal is not; points above and below are on opposite sides, points
+    /// beside the rim are beside it, and points straight above the rim or the diagonal are not.
+    #[test]
+    fn open_square_has_two_sides_and_a_rim() {
+        let geometry = crate::linkage::Geometry {
+            dimension: crate::linkage::Dimension::Three,
+            nodes: vec![
+                Vector3::new(0.0, 0.0, 0.0),
+                Vector3::new(1.0, 0.0, 0.0),
+                Vector3::new(1.0, 1.0, 0.0),
+                Vector3::new(0.0, 1.0, 0.0),
+            ],
+            members: vec![[0, 1], [1, 2], [2, 3], [3, 0], [0, 2]],
+            patches: vec![[0, 1, 2], [0, 2, 3]],
+        };
+        let body = Body::from_geometry("square", geometry, Material::new("m", 1e7, 1e-4));
+        assert_eq!(
+            PatchSurface::of(&body).err(),
+            Some(SurfaceProblem::NotClosed([1, 2]))
+        );
+        let s = PatchSurface::open_shell(&body).unwrap();
+        assert!(s.is_open());
+        assert_eq!(s.rim_edges, vec![[true, true, false], [false, true, true]]);
+        let (mesh, _) = s.mesh(|n| body.nodes[n]).unwrap();
+        let at = |x: Real, y: Real, z: Real| {
+            s.shell_side(&mesh, &Vector3::new(x, y, z), |n| body.nodes[n])
+        };
+        let above = at(0.7, 0.2, 0.3);
+        assert_eq!((above.patch, above.side, above.on_rim), (0, 1.0, false));
+        assert!((above.distance - 0.3).abs() < 1e-15);
+        let below = at(0.2, 0.7, -0.1);
+        assert_eq!((below.patch, below.side, below.on_rim), (1, -1.0, false));
+        assert!(
+            at(0.5, 0.5, 0.2).side == 1.0 && !at(0.5, 0.5, 0.2).on_rim,
+            "over the diagonal"
+        );
+        assert!(!at(1.0, 0.5, -0.2).on_rim, "straight below a rim edge");
+        assert!(
+            at(1.2, 0.5, 0.0).on_rim && at(1.2, 0.5, -0.1).on_rim,
+            "beside the rim"
+        );
+        assert!(at(-0.1, -0.1, 0.1).on_rim, "beside a corner");
     }
 
     #[test]

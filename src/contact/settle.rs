@@ -57,6 +57,11 @@ pub const MIN_DEPTH: Real = 1e-9;
 /// See [`ContactSolver::force_floor`].
 pub const FORCE_FLOOR: Real = 1e-10;
 
+/// A node on the far side of an open shell from where it started the step is in contact when
+/// it is within this many of the shell's mean member lengths of the shell (farther, it went
+/// round the shell or the nearest patch changed, and it is not held).
+pub const SHELL_REACH_MEMBERS: Real = 3.0;
+
 /// One body's part of the coupled solve.
 struct BodyPart {
     dofs: DofMap,
@@ -100,8 +105,13 @@ pub struct ContactSolver {
     node_offsets: Vec<usize>,
     /// Contact surface of each body (2D: its outer boundary), `None` if it has none.
     surfaces: Vec<Option<Surface>>,
-    /// Contact surface of each 3D body: its patches, facing out.
+    /// Contact surface of each 3D body: its patches, facing out (or an open shell).
     patch_surfaces: Vec<Option<PatchSurface>>,
+    /// Per open shell (empty for other bodies), per body, per node: the side of the shell the
+    /// node started the step on (+1 in front of its patches, −1 behind, 0 not known).
+    sides: Vec<Vec<Vec<i8>>>,
+    /// Per body, how far behind it as an open shell a node may be and be held, m.
+    shell_reach: Vec<Real>,
     /// Entries between bodies added to the coupled pattern so far (global free DOFs, r ≥ c).
     coupling: Vec<(usize, usize)>,
     obstacles: Obstacles,
@@ -174,10 +184,10 @@ impl ContactSolver {
         let surfaces: Vec<Option<Surface>> = bodies.iter().map(Surface::of).collect();
         let mut patch_surfaces = Vec::with_capacity(bodies.len());
         for body in bodies {
-            // An open shell is not a contact target yet (its nodes still press on the others).
+            // An open shell is a two-sided target: see `record_sides`.
             patch_surfaces.push(match PatchSurface::of(body) {
                 Ok(surface) => surface,
-                Err(SurfaceProblem::NotClosed(_)) => None,
+                Err(SurfaceProblem::NotClosed(_)) => PatchSurface::open_shell(body),
                 Err(problem) => {
                     return Err(ContactError::Surface {
                         body: body.name.clone(),
@@ -221,11 +231,24 @@ impl ContactSolver {
         }
         .map_err(|e| ContactError::Factorization(e.to_string()))?;
         times.symbolic += t.elapsed().as_secs_f64();
+        let sides = patch_surfaces
+            .iter()
+            .map(|s| match s {
+                Some(s) if s.is_open() => bodies.iter().map(|b| vec![0; b.nodes.len()]).collect(),
+                _ => Vec::new(),
+            })
+            .collect();
+        let shell_reach = bodies
+            .iter()
+            .map(|b| SHELL_REACH_MEMBERS * 100.0 * penetration_tolerance(b))
+            .collect();
         Ok(ContactSolver {
             parts,
             node_offsets,
             surfaces,
             patch_surfaces,
+            sides,
+            shell_reach,
             coupling: Vec::new(),
             obstacles: obstacle_set,
             condensed,
@@ -314,6 +337,7 @@ impl ContactSolver {
             self.active = ContactSet::default();
             self.normals.clear();
         }
+        self.record_sides(bodies);
         self.condensed_step(step, steps, restart);
         self.step = step;
         let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset(step, steps)).collect();
@@ -424,12 +448,19 @@ impl ContactSolver {
                         continue;
                     };
                     let [a, b, cc] = surface.patches[patch];
-                    let t = triangle_projection(
+                    let mut t = triangle_projection(
                         &x,
                         &self.position(bodies, body, a),
                         &self.position(bodies, body, b),
                         &self.position(bodies, body, cc),
                     );
+                    if surface.is_open() {
+                        // Pushed back to the side the node started the step on: behind the
+                        // patch, the normal turns round and the depth is measured from there.
+                        let side = Real::from(self.sides[body][c.body][c.node]);
+                        t.normal = t.normal.map(|n| n * side);
+                        t.depth *= side;
+                    }
                     let penalty = Penalty {
                         stiffness: self.parts[c.body]
                             .penalty
@@ -860,6 +891,77 @@ impl ContactSolver {
         }
     }
 
+    /// For every open shell, the side of it each node of the other bodies is on at the last
+    /// solved state (the start of the step). A node held by the shell keeps the side it had
+    /// (its penalty leaves it a little on the far side); a node lying on the shell takes the
+    /// side of the nodes it is joined to by members (a body resting on the shell is on the side
+    /// of its other nodes); one whose neighbours lie on it too stays unknown and is not held.
+    fn record_sides(&mut self, bodies: &[Body]) {
+        let min_depth = MIN_DEPTH
+            * self
+                .parts
+                .iter()
+                .map(|p| p.tolerance)
+                .fold(Real::INFINITY, Real::min);
+        for shell in 0..self.patch_surfaces.len() {
+            let Some(surface) = self.patch_surfaces[shell].as_ref().filter(|s| s.is_open()) else {
+                continue;
+            };
+            let Some((mesh, _)) = surface.mesh(|n| self.position(bodies, shell, n)) else {
+                continue;
+            };
+            let mut sides = std::mem::take(&mut self.sides[shell]);
+            for (b, body) in bodies.iter().enumerate() {
+                if b == shell {
+                    continue;
+                }
+                let mut held = vec![false; body.nodes.len()];
+                for c in &self.active.contacts {
+                    if let (true, Target::Patch { body: t, .. }) = (c.body == b, c.with) {
+                        if t == shell {
+                            held[c.node] = true;
+                        }
+                    }
+                }
+                let signed: Vec<Real> = (0..body.nodes.len())
+                    .map(|node| {
+                        let x = self.position(bodies, b, node);
+                        let s = surface.shell_side(&mesh, &x, |n| self.position(bodies, shell, n));
+                        if s.distance > min_depth {
+                            s.side * s.distance
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                let mut neighbours = vec![0.0; body.nodes.len()];
+                for member in &body.members {
+                    let [i, j] = member.nodes;
+                    neighbours[i] += signed[j];
+                    neighbours[j] += signed[i];
+                }
+                for node in 0..body.nodes.len() {
+                    if held[node] && sides[b][node] != 0 {
+                        continue;
+                    }
+                    let s = if signed[node] != 0.0 {
+                        signed[node]
+                    } else {
+                        neighbours[node]
+                    };
+                    sides[b][node] = if s > 0.0 {
+                        1
+                    } else if s < 0.0 {
+                        -1
+                    } else {
+                        0
+                    };
+                }
+            }
+            self.sides[shell] = sides;
+        }
+    }
+
     /// Every node inside an obstacle or (2D) inside another body, with what it is deepest in.
     fn query(&self, bodies: &[Body], offsets: &[Vector3<Real>]) -> ContactSet {
         // Deformed boundary polygons and their bounding boxes (the broad phase).
@@ -971,13 +1073,33 @@ impl ContactSolver {
                     consider(target, distances[i]);
                 }
                 for (other, mesh) in meshes.iter().enumerate() {
-                    let Some((mesh, [lo, hi])) = mesh else {
+                    let (Some((mesh, [lo, hi])), Some(surface)) =
+                        (mesh, &self.patch_surfaces[other])
+                    else {
                         continue;
                     };
-                    if other == b || (0..3).any(|k| x[k] < lo[k] || x[k] > hi[k]) {
+                    let open = surface.is_open();
+                    let reach = if open { self.shell_reach[other] } else { 0.0 };
+                    if other == b || (0..3).any(|k| x[k] < lo[k] - reach || x[k] > hi[k] + reach) {
                         continue;
                     }
-                    if let Some((patch, depth)) = PatchSurface::inside(mesh, &x) {
+                    if open {
+                        // Two-sided: held when on the other side from where the step started.
+                        let started = self.sides[other][b][node];
+                        if started == 0 {
+                            continue;
+                        }
+                        let s = surface.shell_side(mesh, &x, |n| self.position(bodies, other, n));
+                        if s.side * Real::from(started) < 0.0 && !s.on_rim && s.distance <= reach {
+                            consider(
+                                Target::Patch {
+                                    body: other,
+                                    patch: s.patch,
+                                },
+                                s.distance,
+                            );
+                        }
+                    } else if let Some((patch, depth)) = PatchSurface::inside(mesh, &x) {
                         consider(Target::Patch { body: other, patch }, depth);
                     }
                 }

@@ -112,7 +112,7 @@ pub(crate) fn obstacle_from(
             }
             let Some(file) = &spec.file else {
                 return Err(fail(
-                    "a mesh needs `file`: an OBJ or ASCII STL file (m), relative to the scene file"
+                    "a mesh needs `file`: an OBJ or STL file (m), relative to the scene file"
                         .to_string(),
                 ));
             };

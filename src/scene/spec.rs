@@ -65,7 +65,7 @@ pub struct ObstacleSpec {
     pub half_height: Option<Real>,
     /// Rotation, degrees: about z in 2D (one number), a rotation vector (axis times angle) in 3D.
     pub rotation: Option<Vec<Real>>,
-    /// Triangle mesh file of a `"mesh"` obstacle (OBJ or ASCII STL, m), relative to the scene.
+    /// Triangle mesh file of a `"mesh"` obstacle (OBJ, or ASCII or binary STL, m), relative to the scene.
     pub file: Option<String>,
     /// Translation reached at the last step, m.
     pub travel: Option<Vec<Real>>,
