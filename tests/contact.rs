@@ -896,3 +896,81 @@ fn box_pressed_on_an_open_shell_from_either_side_is_held() {
         }
     }
 }
+
+/// A box held sideways, 0.9 m above a floor and pushed down by 1000 N: at first none of its
+/// nodes is near enough the floor to be a contact candidate of the condensed path; it falls,
+/// its bottom nodes reach the floor, the candidates widen to them, and the answer is the coupled
+/// solve's (displacements to 1e-6 of the largest) with the floor carrying the whole load (1e-6).
+#[test]
+fn contacts_beyond_the_candidates_widen_them() {
+    let scene = r#"
+name = "falling_box"
+steps = 2
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "box"
+box_lattice = { size = [1.0, 1.0, 1.0], cells = [4, 4, 4] }
+material = "rubber"
+[[bodies.supports]]
+on_line = { point = [0.0, 0.0, 0.0], direction = [0.0, 1.0, 0.0] }
+fix = ["x", "z"]
+[[bodies.supports]]
+on_line = { point = [1.0, 0.0, 1.0], direction = [0.0, 1.0, 0.0] }
+fix = ["x", "z"]
+[[bodies.loads]]
+on_plane = { point = [0.0, 1.0, 0.0], normal = [0.0, 1.0, 0.0] }
+total_force = [0.0, -1000.0, 0.0]
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, -0.9, 0.0]
+normal = [0.0, 1.0, 0.0]
+[contact]
+max_iterations = 100
+"#;
+    let mut world = build_world(scene, Path::new("falling_box.toml")).unwrap();
+    let sim = Simulation::new(&world).unwrap();
+    let before = sim
+        .contact
+        .as_ref()
+        .and_then(|c| c.lock().unwrap().candidate_nodes(0))
+        .expect("condensed");
+    assert_eq!(before, 0, "nothing is near the floor at first");
+    let condensed: Vec<_> = (0..=world.steps).map(|k| sim.step(k).unwrap()).collect();
+    let after = sim
+        .contact
+        .as_ref()
+        .and_then(|c| c.lock().unwrap().candidate_nodes(0))
+        .expect("still condensed");
+    assert!(
+        after >= 25,
+        "the bottom face joined the candidates: {after}"
+    );
+    world.contact.condense = false;
+    let coupled = run_all(&world);
+    for ((a, _), (b, _)) in condensed.iter().zip(&coupled).skip(1) {
+        let f = 1000.0 * a.load_factor;
+        let floor: f64 = a.bodies[0].contacts.iter().map(|c| c.force[1]).sum();
+        assert!(
+            (floor - f).abs() <= 1e-6 * f,
+            "floor carries {floor} of {f}"
+        );
+        let largest = b.bodies[0]
+            .displacements
+            .iter()
+            .flat_map(|u| u.iter())
+            .fold(0.0_f64, |m, x| m.max(x.abs()));
+        for (ua, ub) in a.bodies[0]
+            .displacements
+            .iter()
+            .zip(&b.bodies[0].displacements)
+        {
+            for (x, y) in ua.iter().zip(ub) {
+                assert!((x - y).abs() <= 1e-6 * largest, "{x} vs {y}");
+            }
+        }
+    }
+}

@@ -276,6 +276,12 @@ impl ContactSolver {
         self.condensed.is_some()
     }
 
+    /// Contact candidates of `body` on the condensed path (nodes; `None` on the coupled path).
+    pub fn candidate_nodes(&self, body: usize) -> Option<usize> {
+        let c = self.condensed.as_ref()?.get(body)?;
+        Some(c.body.nodes.iter().filter(|&&m| m).count())
+    }
+
     /// The coupled system of all bodies, analyzed (when leaving the condensed path).
     fn build_coupled(&mut self) -> Result<(), ContactError> {
         let t = Instant::now();

@@ -29,6 +29,8 @@ pub(super) struct Condensation {
     pub(super) alpha_expanded: Vec<Real>,
     /// Load plus contact forces per free DOF at the last full solve, N.
     pub(super) rhs_expanded: Vec<Real>,
+    /// The step being solved and the number of steps (the load of a body condensed again).
+    pub(super) step: (usize, usize),
     /// The last two solved steps: (step, f̂, α), oldest first (the next step starts from their
     /// extrapolation).
     pub(super) history: Vec<(usize, Vec<Real>, Vec<Real>)>,
@@ -122,6 +124,7 @@ impl Condensation {
             alpha_expanded: vec![0.0; r],
             rhs_expanded: vec![0.0; body.slot.len()],
             history: Vec::new(),
+            step: (0, 1),
             fresh: false,
             body,
         }
@@ -169,6 +172,7 @@ impl ContactSolver {
             c.load = load;
             c.base = base;
             c.fresh = false;
+            c.step = (step, steps);
         }
     }
 
@@ -497,6 +501,9 @@ impl ContactSolver {
             c.history.clear();
             c.fresh = false;
             c.body = grown;
+            let (load, base) = c.body.step_load(c.step.0, c.step.1);
+            c.load = load;
+            c.base = base;
         }
         if ok {
             self.condensed = Some(condensed);
