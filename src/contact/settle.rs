@@ -634,16 +634,7 @@ impl ContactSolver {
         offsets: &[Vector3<Real>],
         step: usize,
     ) -> Result<(usize, bool), ContactError> {
-        let tolerance = bodies
-            .iter()
-            .map(|b| b.newton.tolerance)
-            .fold(Real::INFINITY, Real::min)
-            .min(1e-10);
-        let max_iterations = bodies
-            .iter()
-            .map(|b| b.newton.max_iterations)
-            .max()
-            .unwrap_or(30);
+        let (tolerance, max_iterations) = newton_limits(bodies);
         let mut history = Vec::new();
         let mut iterations = 0;
         let mut last_step = Real::INFINITY;
@@ -1307,6 +1298,22 @@ fn loads_at(body: &Body, step: usize, steps: usize) -> Vec<Real> {
 /// Prescribed displacement per body DOF at `step`, m (see [`prescribed_displacements`]).
 fn prescribed_at(body: &Body, step: usize, steps: usize) -> Vec<Real> {
     prescribed_displacements(body, |schedule| schedule.factor(step, steps))
+}
+
+/// The Newton tolerance of a contact scene (the smallest of the bodies', at most 1e-10) and the
+/// iterations allowed per contact set (the largest of the bodies').
+fn newton_limits(bodies: &[Body]) -> (Real, usize) {
+    let tolerance = bodies
+        .iter()
+        .map(|b| b.newton.tolerance)
+        .fold(Real::INFINITY, Real::min)
+        .min(1e-10);
+    let max_iterations = bodies
+        .iter()
+        .map(|b| b.newton.max_iterations)
+        .max()
+        .unwrap_or(30);
+    (tolerance, max_iterations)
 }
 
 fn norm(v: &[Real]) -> Real {

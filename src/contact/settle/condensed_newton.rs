@@ -1,7 +1,7 @@
 //! The settle loop's Newton iteration when every body is linear: on the contact candidates
 //! only, with each body factored once per run (see [`crate::contact::condensed`]).
 
-use super::{ContactSolver, STABILISATION};
+use super::{newton_limits, ContactSolver, STABILISATION};
 use crate::contact::boundary::Surface;
 use crate::contact::condensed::{
     CondensedBody, ContactJacobian, ContactRow, Correction, NOT_CANDIDATE,
@@ -544,16 +544,7 @@ impl ContactSolver {
         step: usize,
         jacobian: &mut Option<ContactJacobian>,
     ) -> Result<(usize, bool), ContactError> {
-        let tolerance = bodies
-            .iter()
-            .map(|b| b.newton.tolerance)
-            .fold(Real::INFINITY, Real::min)
-            .min(1e-10);
-        let max_iterations = bodies
-            .iter()
-            .map(|b| b.newton.max_iterations)
-            .max()
-            .unwrap_or(30);
+        let (tolerance, max_iterations) = newton_limits(bodies);
         let stabilisation = STABILISATION
             * self
                 .parts
