@@ -974,3 +974,61 @@ max_iterations = 100
         }
     }
 }
+
+/// The bar of `bar_pressed_onto_floor_sinks_force_over_penalty` pushed into the floor by a
+/// prescribed displacement d of its top instead of a force: the bar (k = E A / L) and the
+/// penalty κ act in series, so the foot sinks p = d k / (k + κ) and the floor pushes back with
+/// κ p, at every step (to 1e-9), on the condensed path and on the coupled one.
+#[test]
+fn bar_pushed_by_a_prescribed_displacement_shares_it_with_the_penalty() {
+    let scene = r#"
+name = "bar_pushed"
+steps = 2
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "bar"
+nodes = "bar.nodes"
+links = "bar.links"
+material = "steel"
+[[bodies.supports]]
+nodes = [1]
+fix = ["x"]
+[[bodies.supports]]
+nodes = [2]
+fix = ["x", "y"]
+displacement = [0.0, -1e-3]
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+[contact]
+penalty = 1e6
+"#;
+    let (_dir, path) = scene_with(&[("bar.nodes", BAR_NODES), ("bar.links", BAR_LINKS)], scene);
+    let (k, kappa) = (200e9 * 1e-4 / 1.0, 1e6);
+    for condense in [true, false] {
+        let mut world = load_scene(&path).unwrap();
+        world.contact.condense = condense;
+        for (result, _) in run_all(&world).into_iter().skip(1) {
+            let d = 1e-3 * result.load_factor;
+            let p = d * k / (k + kappa);
+            let bar = &result.bodies[0];
+            assert_eq!(bar.contacts.len(), 1, "{:?}", bar.contacts);
+            let c = &bar.contacts[0];
+            assert!(
+                (c.depth - p).abs() <= 1e-9 * p,
+                "condense {condense}: depth {} vs {p}",
+                c.depth
+            );
+            assert!(
+                (c.force[1] - kappa * p).abs() <= 1e-9 * kappa * p,
+                "force {:?}",
+                c.force
+            );
+        }
+    }
+}
