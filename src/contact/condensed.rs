@@ -15,8 +15,10 @@
 //! problem of the size of the active contacts (see [`contact_newton_step`]); the whole
 //! displacement field costs one solve per body per load step ([`CondensedBody::expand`]).
 
-use crate::linkage::cholesky::SparseCholesky;
+use crate::linkage::cholesky::{CholeskyError, SparseCholesky};
+use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::rigid_modes::{free_rigid_modes, pinned_dofs_avoiding};
+use crate::linkage::Mechanism;
 use crate::linkage::{
     member_block, prescribed_displacements, Body, DofMap, Schedule, StiffnessAssembly,
 };
@@ -29,6 +31,27 @@ pub(crate) const NOT_CANDIDATE: usize = usize::MAX;
 
 /// The most candidate DOFs a body may have (its compliance is dense: 8,000 DOFs take 512 MB).
 pub(crate) const MAX_CANDIDATE_DOFS: usize = 8_000;
+
+/// Why a body was not condensed (the caller then solves the coupled system).
+#[derive(Debug)]
+pub(crate) enum CondenseFailure {
+    /// Nodes move without stretching a member, with the rigid motions pinned.
+    Mechanism(Box<Mechanism>),
+    /// Another reason (too many candidates, a failed analysis): the coupled solve copes.
+    Other,
+}
+
+impl From<String> for CondenseFailure {
+    fn from(_: String) -> Self {
+        CondenseFailure::Other
+    }
+}
+
+impl From<&str> for CondenseFailure {
+    fn from(_: &str) -> Self {
+        CondenseFailure::Other
+    }
+}
 
 /// One load schedule of a body: its load at full value and the displacement it gives.
 struct Pattern {
@@ -78,14 +101,14 @@ impl CondensedBody {
         dofs: &DofMap,
         assembly: &StiffnessAssembly,
         nodes: Vec<bool>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, CondenseFailure> {
         let t = std::time::Instant::now();
         let n = assembly.n;
         let d = dofs.dofs_per_node;
         let mut slot = vec![NOT_CANDIDATE; n];
         let m = assembly.groups.iter().filter(|&&g| nodes[g]).count();
         if m > MAX_CANDIDATE_DOFS {
-            return Err(format!("{m} candidate DOFs (at most {MAX_CANDIDATE_DOFS})"));
+            return Err(format!("{m} candidate DOFs (at most {MAX_CANDIDATE_DOFS})").into());
         }
         // Each rigid motion scaled to move the farthest DOF by one: its amplitude is a length
         // and its stiffness `Bᵀ A⁻¹ B` compares with the penalties.
@@ -136,7 +159,17 @@ impl CondensedBody {
         let largest_diagonal = (0..n)
             .map(|c| values[assembly.col_ptr[c]])
             .fold(0.0, Real::max);
-        cholesky.factorize(&values).map_err(|e| e.to_string())?;
+        match cholesky.factorize(&values) {
+            Ok(()) => {}
+            // The rigid motions are pinned: what is left singular moves inside the body.
+            Err(CholeskyError::NonPositivePivot { dof })
+            | Err(CholeskyError::NearlySingular { dof, .. }) => {
+                let mechanism =
+                    diagnose_mechanism(body, dofs, assembly, &values, &mut cholesky, dof);
+                return Err(CondenseFailure::Mechanism(Box::new(mechanism)));
+            }
+            Err(_) => return Err(CondenseFailure::Other),
+        }
         let (order, factor) = cholesky
             .trailing_factor(m)
             .ok_or("the factor has no trailing block")?;

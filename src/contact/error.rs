@@ -22,6 +22,16 @@ pub enum ContactError {
         /// Active contacts at the end.
         contacts: usize,
     },
+    /// A body is a mechanism (nodes move without stretching a member) and no contact held it.
+    #[error(
+        "step {step}: {mechanism}; no contact held it either in the contact iterations allowed"
+    )]
+    Mechanism {
+        /// The step.
+        step: usize,
+        /// The moving nodes.
+        mechanism: Box<crate::linkage::Mechanism>,
+    },
     /// Newton did not converge within one contact iteration.
     #[error("step {step}: equilibrium with contact did not converge in {iterations} Newton iterations (relative residuals: [{}]): use more steps, or a smaller [contact] penalty", history.iter().map(|r| format!("{r:.1e}")).collect::<Vec<_>>().join(", "))]
     NotConverged {

@@ -10,6 +10,7 @@
 //! warning, as does running out of contact iterations.
 
 use crate::contact::boundary::{inside_polygon, segment_projection, Surface};
+use crate::contact::condensed::CondenseFailure;
 use crate::contact::coupled_system::CoupledSystem;
 use crate::contact::patch_surface::{triangle_projection, PatchSurface};
 use crate::contact::{
@@ -132,6 +133,9 @@ pub struct ContactSolver {
     /// Every body linear: each factored once per run and condensed on its contact candidates
     /// (`None`: the coupled solve).
     condensed: Option<Vec<Condensation>>,
+    /// A body found to move inside itself (beyond rigid motions) when it was condensed: named
+    /// if no contact holds it either.
+    mechanism: Option<Box<crate::linkage::Mechanism>>,
     /// The factored Jacobian of the condensed contact problem and the set it was made for.
     condensed_jacobian: Option<(ContactSet, crate::contact::condensed::ContactJacobian)>,
     /// Time spent so far in each phase, s.
@@ -198,6 +202,7 @@ impl ContactSolver {
         }
         let obstacle_set = Obstacles::new(obstacles).map_err(ContactError::Obstacle)?;
         let mut condensed = None;
+        let mut mechanism = None;
         if settings.condense && bodies.iter().all(|b| !b.is_nonlinear()) {
             // Obstacle offsets along their travel, sampled (a candidate missed is added later).
             let travels: Vec<Vec<Vector3<Real>>> = obstacles
@@ -209,13 +214,17 @@ impl ContactSolver {
             let mut built = Vec::with_capacity(bodies.len());
             for ((body, part), mark) in bodies.iter().zip(&parts).zip(marks) {
                 match Condensation::build(body, &part.dofs, &part.assembly, mark) {
-                    Some(c) => {
+                    Ok(c) => {
                         times.symbolic += c.seconds[0];
                         times.numeric += c.seconds[1];
                         times.solve += c.seconds[2];
                         built.push(Condensation::new(c, body.dof_count()));
                     }
-                    None => break,
+                    Err(CondenseFailure::Mechanism(m)) => {
+                        mechanism = Some(m);
+                        break;
+                    }
+                    Err(CondenseFailure::Other) => break,
                 }
             }
             if built.len() == bodies.len() {
@@ -253,6 +262,7 @@ impl ContactSolver {
             obstacles: obstacle_set,
             condensed,
             condensed_jacobian: None,
+            mechanism,
             system,
             settings,
             active: ContactSet::default(),
@@ -387,6 +397,9 @@ impl ContactSolver {
             if !settled {
                 // A stabilised move toward the contacts: look again, no equilibrium yet.
                 if out.contact_iterations >= self.settings.max_iterations {
+                    if let Some(m) = self.mechanism.take() {
+                        return Err(ContactError::Mechanism { step, mechanism: m });
+                    }
                     return Err(ContactError::Unsupported {
                         step,
                         body: self.moving_body(bodies),

@@ -42,7 +42,7 @@ mod iterative_solver;
 mod kinematics;
 pub mod ldlt;
 mod material;
-mod mechanism;
+pub(crate) mod mechanism;
 mod member_response;
 mod member_stiffness;
 mod newton;

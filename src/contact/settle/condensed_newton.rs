@@ -4,7 +4,7 @@
 use super::{newton_limits, ContactSolver, STABILISATION};
 use crate::contact::boundary::Surface;
 use crate::contact::condensed::{
-    CondensedBody, ContactJacobian, ContactRow, Correction, NOT_CANDIDATE,
+    CondenseFailure, CondensedBody, ContactJacobian, ContactRow, Correction, NOT_CANDIDATE,
 };
 use crate::contact::patch_surface::PatchSurface;
 use crate::contact::{penetration_tolerance, ContactError, ContactSet, Obstacles};
@@ -130,14 +130,14 @@ impl Condensation {
         }
     }
 
-    /// Condense `body` on `nodes`; `None` if it cannot be (the caller solves coupled).
+    /// Condense `body` on `nodes`; `Err` if it cannot be (the caller solves coupled).
     pub(super) fn build(
         body: &Body,
         dofs: &DofMap,
         assembly: &StiffnessAssembly,
         nodes: Vec<bool>,
-    ) -> Option<CondensedBody> {
-        CondensedBody::new(body, dofs, assembly, nodes).ok()
+    ) -> Result<CondensedBody, CondenseFailure> {
+        CondensedBody::new(body, dofs, assembly, nodes)
     }
 }
 
@@ -485,7 +485,7 @@ impl ContactSolver {
             }
             widen(body, &mut mark, 2);
             let part = &self.parts[b];
-            let Some(grown) = Condensation::build(body, &part.dofs, &part.assembly, mark) else {
+            let Ok(grown) = Condensation::build(body, &part.dofs, &part.assembly, mark) else {
                 ok = false;
                 break;
             };
