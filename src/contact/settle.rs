@@ -55,6 +55,10 @@ struct Evaluated {
 /// tolerance (1e-9 of 1% of a member: round-off does not make contacts).
 pub const MIN_DEPTH: Real = 1e-9;
 
+/// How far (in barycentric weight, a fraction of the patch) a node may lie beyond the patch it
+/// pressed on and keep it (see `ContactSolver::keep_patches`).
+pub const KEEP_PATCH: Real = 0.05;
+
 /// See [`ContactSolver::force_floor`].
 pub const FORCE_FLOOR: Real = 1e-10;
 
@@ -378,13 +382,13 @@ impl ContactSolver {
             out.newton_iterations += iterations;
             out.stabilised |= !settled;
             let t = Instant::now();
-            let mut found = self.query(bodies, &offsets);
+            let mut found = self.keep_patches(bodies, &set, self.query(bodies, &offsets));
             self.query_seconds += t.elapsed().as_secs_f64();
             if settled && found == set && self.condensed.is_some() {
                 // Settled on the candidates: solve for every node, and look again with them.
                 let differs = self.expand_condensed();
                 let t = Instant::now();
-                found = self.query(bodies, &offsets);
+                found = self.keep_patches(bodies, &set, self.query(bodies, &offsets));
                 self.query_seconds += t.elapsed().as_secs_f64();
                 // The placement was off by the compliance's round-off (a penalty turns 1e-13 m
                 // into forces the tolerance sees): above a tenth of the tolerance, Newton again
@@ -973,6 +977,67 @@ impl ContactSolver {
     }
 
     /// Every node inside an obstacle or (2D) inside another body, with what it is deepest in.
+    /// `found`, with a node that presses on a patch of the same body as in `solved` keeping the
+    /// patch of `solved` while it still projects onto it or within `KEEP_PATCH` of it: a node
+    /// on the edge between two patches (coincident faces of two boxes, sliding sideways by
+    /// round-off as the bodies squeeze) is then not moved from one to the other at every
+    /// query, which made the set flip back and forth. The force goes to the kept patch's nodes
+    /// (equal and opposite all the same); on a curved surface the depth measured from the kept
+    /// patch's plane differs by about (distance beyond its edge)² / radius.
+    fn keep_patches(&self, bodies: &[Body], solved: &ContactSet, found: ContactSet) -> ContactSet {
+        let before: HashMap<(usize, usize), Target> = solved
+            .contacts
+            .iter()
+            .map(|c| ((c.body, c.node), c.with))
+            .collect();
+        let mut changed = false;
+        let mut contacts = found.contacts;
+        for c in &mut contacts {
+            let (Target::Patch { body, .. }, Some(&old)) = (c.with, before.get(&(c.body, c.node)))
+            else {
+                continue;
+            };
+            let Target::Patch {
+                body: old_body,
+                patch,
+            } = old
+            else {
+                continue;
+            };
+            if old_body != body || old == c.with {
+                continue;
+            }
+            let Some(surface) = self.patch_surfaces[body].as_ref() else {
+                continue;
+            };
+            let [a, b, cc] = surface.patches[patch];
+            let (pa, pb, pc) = (
+                self.position(bodies, body, a),
+                self.position(bodies, body, b),
+                self.position(bodies, body, cc),
+            );
+            let cross = (pb - pa).cross(&(pc - pa));
+            let area2 = cross.norm();
+            if area2.is_nan() || area2 <= 0.0 {
+                continue;
+            }
+            let n = cross / area2;
+            let x = self.position(bodies, c.body, c.node);
+            let p = x + n * (pa - x).dot(&n);
+            let wa = (pb - p).cross(&(pc - p)).dot(&n) / area2;
+            let wb = (pc - p).cross(&(pa - p)).dot(&n) / area2;
+            if [wa, wb, 1.0 - wa - wb].iter().all(|&w| w >= -KEEP_PATCH) {
+                c.with = old;
+                changed = true;
+            }
+        }
+        if changed {
+            ContactSet::new(contacts)
+        } else {
+            ContactSet { contacts }
+        }
+    }
+
     fn query(&self, bodies: &[Body], offsets: &[Vector3<Real>]) -> ContactSet {
         // Deformed boundary polygons and their bounding boxes (the broad phase).
         let polygons: Vec<Option<Polygon>> = self
