@@ -21,6 +21,7 @@ fn square() -> (ModelFile, StepResult) {
     ];
     let model = ModelFile {
         scene: "square".into(),
+        obstacles: Vec::new(),
         bodies: vec![ModelBody {
             name: "b".into(),
             dimension: 2,
@@ -156,6 +157,7 @@ fn two_patches() -> (ModelFile, StepResult) {
     nodes.extend(tri([1.5, 0.0, 0.0], Vector3::new(0.45, -0.6, 0.66)));
     let model = ModelFile {
         scene: "lit".into(),
+        obstacles: Vec::new(),
         bodies: vec![ModelBody {
             name: "p".into(),
             dimension: 3,

@@ -229,3 +229,217 @@ vtk = true
         );
     }
 }
+
+const READ_FIELD: &str = r#"
+import json, sys, meshio
+m = meshio.read(sys.argv[1])
+print(json.dumps({k: v.tolist() for k, v in m.field_data.items()}))
+"#;
+
+fn field_data(python: &Path, file: &Path) -> Value {
+    let o = Command::new(python)
+        .args(["-c", READ_FIELD])
+        .arg(file)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+fn point(v: &Value) -> [f64; 3] {
+    [f(&v[0]), f(&v[1]), f(&v[2])]
+}
+
+#[test]
+fn obstacles_are_drawn_where_contact_sees_them() {
+    let python = meshio_python();
+    let out = tempfile::tempdir().unwrap();
+
+    // The press block of shell_on_block_moving at the last step: 8 corners at
+    // centre + travel ± half extents, 12 triangles, all of obstacle 1 ("block").
+    let dir = run_with_vtk("scenes/shell_on_block_moving.toml", out.path());
+    let v = read_vtu(&python, &dir.join("vtk/obstacles_0004.vtu"));
+    let points = v["points"].as_array().unwrap();
+    assert_eq!(points.len(), 8);
+    let centre = [1.93, -0.35 + 0.02, 0.0];
+    let half = [0.15, 0.1, 0.3];
+    for signs in 0..8 {
+        let corner: Vec<f64> = (0..3)
+            .map(|k| {
+                let s = if signs & (1 << k) == 0 { -1.0 } else { 1.0 };
+                centre[k] + s * half[k]
+            })
+            .collect();
+        let found = points.iter().any(|p| {
+            let p = point(p);
+            (0..3).all(|k| (p[k] - corner[k]).abs() <= 1e-12)
+        });
+        assert!(found, "corner {corner:?} not among {points:?}");
+    }
+    let cells = v["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 1);
+    assert_eq!(cells[0][0], "triangle");
+    assert_eq!(cells[0][1].as_array().unwrap().len(), 12);
+    let ids = v["cell_data"]["obstacle"][0].as_array().unwrap();
+    assert!(ids.iter().all(|i| i.as_i64() == Some(1)));
+    assert_eq!(
+        field_data(&python, &dir.join("vtk/obstacles_0004.vtu"))["block"][0],
+        1
+    );
+    // Step 0: the block where the scene puts it.
+    let v0 = read_vtu(&python, &dir.join("vtk/obstacles_0000.vtu"));
+    let lowest = v0["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| point(p)[1])
+        .fold(f64::INFINITY, f64::min);
+    assert!((lowest - (-0.45)).abs() <= 1e-12, "{lowest}");
+    // The collection holds the bodies as part 0 and the obstacles as part 1.
+    let pvd = std::fs::read_to_string(dir.join("vtk/shell_on_block_moving.pvd")).unwrap();
+    assert_eq!(pvd.matches("part=\"1\"").count(), 5, "{pvd}");
+    assert!(
+        pvd.contains("part=\"1\" file=\"obstacles_0004.vtu\""),
+        "{pvd}"
+    );
+    // The bodies' file has the shell only.
+    let bodies = read_vtu(&python, &dir.join("vtk/0004.vtu"));
+    let r = step(&dir, 4);
+    assert_eq!(
+        bodies["points"].as_array().unwrap().len(),
+        r.bodies[0].positions.len()
+    );
+
+    // A ball pressed on a plate (3D) with a floor: every vertex of the ball at its radius
+    // from its centre moved by the travel; the floor a square in its plane.
+    let text = r#"
+name = "ball_press"
+steps = 2
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "plate"
+box_lattice = { size = [1.0, 0.1, 1.0], cells = [4, 1, 4] }
+[[bodies.supports]]
+on_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
+fix = ["x", "y", "z"]
+[[obstacles]]
+name = "ball"
+shape = "ball"
+center = [0.5, 0.4, 0.5]
+radius = 0.25
+travel = [0.1, -0.05, 0.2]
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, -0.5, 0.0]
+normal = [0.0, 1.0, 0.0]
+[output]
+vtk = true
+"#;
+    let world = linkage::scene::build_world(text, &out.path().join("b.toml")).unwrap();
+    run(&world, out.path(), &|| {}).unwrap();
+    let file = out.path().join("ball_press/vtk/obstacles_0002.vtu");
+    let v = read_vtu(&python, &file);
+    let ids: Vec<i64> = v["cell_data"]["obstacle"][0]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i.as_i64().unwrap())
+        .collect();
+    let conn = v["cells"][0][1].as_array().unwrap();
+    assert_eq!(v["cells"][0][0], "triangle");
+    let centre = [0.6, 0.35, 0.7];
+    let mut ball_vertices = std::collections::BTreeSet::new();
+    let mut floor_vertices = std::collections::BTreeSet::new();
+    for (t, id) in conn.iter().zip(&ids) {
+        for i in t.as_array().unwrap() {
+            let i = i.as_u64().unwrap();
+            if *id == 1 {
+                ball_vertices.insert(i);
+            } else {
+                assert_eq!(*id, 2);
+                floor_vertices.insert(i);
+            }
+        }
+    }
+    assert_eq!(ids.iter().filter(|i| **i == 2).count(), 2);
+    let points = v["points"].as_array().unwrap();
+    assert!(ball_vertices.len() > 400, "{}", ball_vertices.len());
+    for &i in &ball_vertices {
+        let p = point(&points[i as usize]);
+        let r =
+            ((p[0] - centre[0]).powi(2) + (p[1] - centre[1]).powi(2) + (p[2] - centre[2]).powi(2))
+                .sqrt();
+        assert!((r - 0.25).abs() <= 1e-9, "vertex {i} at {r}");
+    }
+    assert_eq!(floor_vertices.len(), 4);
+    for &i in &floor_vertices {
+        assert_eq!(point(&points[i as usize])[1], -0.5);
+    }
+    let names = field_data(&python, &file);
+    assert_eq!(
+        (names["ball"][0].as_i64(), names["floor"][0].as_i64()),
+        (Some(1), Some(2))
+    );
+}
+
+#[test]
+fn obstacles_of_a_2d_scene_are_their_cut_by_the_plane() {
+    let python = meshio_python();
+    let text = r#"
+name = "disk_on_floor"
+steps = 1
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "bar"
+rectangle = { width = 1.0, height = 0.5, cells = [2, 1] }
+[[bodies.supports]]
+nearest = [0.0, 0.0]
+fix = ["x", "y"]
+[[obstacles]]
+name = "disk"
+shape = "ball"
+center = [0.5, 1.0]
+radius = 0.3
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, -0.1]
+normal = [0.0, 1.0]
+[output]
+vtk = true
+"#;
+    let out = tempfile::tempdir().unwrap();
+    let world = linkage::scene::build_world(text, &out.path().join("s.toml")).unwrap();
+    run(&world, out.path(), &|| {}).unwrap();
+    let v = read_vtu(
+        &python,
+        &out.path().join("disk_on_floor/vtk/obstacles_0001.vtu"),
+    );
+    assert_eq!(v["cells"].as_array().unwrap().len(), 1);
+    assert_eq!(v["cells"][0][0], "line");
+    let ids = v["cell_data"]["obstacle"][0].as_array().unwrap();
+    let points = v["points"].as_array().unwrap();
+    let mut disk_segments = 0;
+    for (l, id) in v["cells"][0][1].as_array().unwrap().iter().zip(ids) {
+        for i in l.as_array().unwrap() {
+            let p = point(&points[i.as_u64().unwrap() as usize]);
+            assert_eq!(p[2], 0.0);
+            if id.as_i64() == Some(1) {
+                // On a chord of the circle: within its sagitta inside.
+                let r = ((p[0] - 0.5).powi(2) + (p[1] - 1.0).powi(2)).sqrt();
+                assert!((0.3 * 0.98..=0.3 + 1e-12).contains(&r), "{r}");
+            } else {
+                assert!((p[1] + 0.1).abs() <= 1e-12, "{p:?}");
+            }
+        }
+        disk_segments += usize::from(id.as_i64() == Some(1));
+    }
+    assert!(disk_segments >= 16, "{disk_segments}");
+}

@@ -4,11 +4,12 @@ pub use self::boundary::boundary_loop;
 pub use self::contact_set::{ActiveContact, ContactSet, NodeContact, Target};
 pub use self::error::ContactError;
 pub use self::obstacle::{Obstacle, ObstacleShape};
-pub use self::obstacles::{mesh_collider, ObstacleProjection, Obstacles};
+pub use self::obstacles::{mesh_collider, primitive_collider, ObstacleProjection, Obstacles};
 pub use self::patch_surface::{PatchSurface, SurfaceProblem};
 pub use self::penalty::{default_penalty, penetration_tolerance, Penalty, PENALTY_FACTOR};
 pub use self::settings::ContactSettings;
 pub use self::settle::{ContactSolver, ContactStep};
+pub use self::surface::{cut_by_z0, obstacle_surface, Surface};
 
 mod boundary;
 mod condensed;
@@ -21,3 +22,4 @@ mod patch_surface;
 mod penalty;
 mod settings;
 mod settle;
+mod surface;

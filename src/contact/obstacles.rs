@@ -28,11 +28,11 @@ pub struct Obstacles {
     pub entries: Vec<(ColliderHandle, Obstacle)>,
 }
 
-fn to_glam(v: &Vector3<Real>) -> Vector {
+pub(crate) fn to_glam(v: &Vector3<Real>) -> Vector {
     Vector::new(v.x, v.y, v.z)
 }
 
-fn from_glam(v: Vector) -> Vector3<Real> {
+pub(crate) fn from_glam(v: Vector) -> Vector3<Real> {
     Vector3::new(v.x, v.y, v.z)
 }
 
@@ -51,6 +51,41 @@ pub fn mesh_collider(
     .map_err(|e| format!("the triangle mesh cannot be built: {e}"))
 }
 
+/// The fixed collider of every shape but a mesh (`None` for a mesh, which has its own
+/// vertices: [`mesh_collider`]), placed at the shape's step-0 position and rotation.
+pub fn primitive_collider(shape: &ObstacleShape) -> Option<ColliderBuilder> {
+    Some(match shape {
+        ObstacleShape::HalfSpace { point, normal } => {
+            ColliderBuilder::new(SharedShape::halfspace(to_glam(&normal.normalize())))
+                .translation(to_glam(point))
+        }
+        ObstacleShape::Cuboid {
+            center,
+            half_extents,
+            rotation,
+        } => ColliderBuilder::cuboid(half_extents.x, half_extents.y, half_extents.z)
+            .position(Pose::new(to_glam(center), to_glam(rotation))),
+        ObstacleShape::Ball { center, radius } => {
+            ColliderBuilder::ball(*radius).translation(to_glam(center))
+        }
+        ObstacleShape::Cylinder {
+            center,
+            radius,
+            half_height,
+            rotation,
+        } => ColliderBuilder::cylinder(*half_height, *radius)
+            .position(Pose::new(to_glam(center), to_glam(rotation))),
+        ObstacleShape::Capsule {
+            center,
+            radius,
+            half_height,
+            rotation,
+        } => ColliderBuilder::capsule_y(*half_height, *radius)
+            .position(Pose::new(to_glam(center), to_glam(rotation))),
+        ObstacleShape::Mesh { .. } => return None,
+    })
+}
+
 impl Obstacles {
     /// Insert every obstacle of `list` as a fixed collider. Fails (naming the obstacle) for a
     /// triangle mesh parry cannot build.
@@ -59,37 +94,13 @@ impl Obstacles {
         let mut entries = Vec::with_capacity(list.len());
         for obstacle in list {
             let collider = match &obstacle.shape {
-                ObstacleShape::HalfSpace { point, normal } => {
-                    ColliderBuilder::new(SharedShape::halfspace(to_glam(&normal.normalize())))
-                        .translation(to_glam(point))
-                }
-                ObstacleShape::Cuboid {
-                    center,
-                    half_extents,
-                    rotation,
-                } => ColliderBuilder::cuboid(half_extents.x, half_extents.y, half_extents.z)
-                    .position(Pose::new(to_glam(center), to_glam(rotation))),
-                ObstacleShape::Ball { center, radius } => {
-                    ColliderBuilder::ball(*radius).translation(to_glam(center))
-                }
-                ObstacleShape::Cylinder {
-                    center,
-                    radius,
-                    half_height,
-                    rotation,
-                } => ColliderBuilder::cylinder(*half_height, *radius)
-                    .position(Pose::new(to_glam(center), to_glam(rotation))),
-                ObstacleShape::Capsule {
-                    center,
-                    radius,
-                    half_height,
-                    rotation,
-                } => ColliderBuilder::capsule_y(*half_height, *radius)
-                    .position(Pose::new(to_glam(center), to_glam(rotation))),
                 ObstacleShape::Mesh {
                     vertices,
                     triangles,
                 } => mesh_collider(vertices, triangles)?,
+                shape => primitive_collider(shape).ok_or_else(|| {
+                    format!("obstacle '{}': no collider for its shape", obstacle.name)
+                })?,
             };
             let handle = colliders.insert(collider.build());
             entries.push((handle, obstacle.clone()));

@@ -27,6 +27,7 @@ pub fn bent_shell(rings: usize, sectors: usize) -> Result<(ModelFile, Vec<StepRe
     let g = cylindrical_shell(0.25, 2.0, rings, sectors).map_err(|e| e.to_string())?;
     let model = ModelFile {
         scene: "bench_shell".to_string(),
+        obstacles: Vec::new(),
         bodies: vec![ModelBody {
             name: "shell".to_string(),
             dimension: 3,

@@ -2,7 +2,7 @@
 
 pub use self::build::{build_world, load_scene, SceneError};
 pub use self::extra_outputs::DrawResults;
-pub use self::model_file::{ModelBody, ModelFile, SupportedNode};
+pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::results::{
     BodyResult, BodySize, ContactForce, NodeForce, PairForce, PhaseSeconds, StepResult,

@@ -1,9 +1,11 @@
 //! `model.json`: the undeformed model of a run (what the step files do not repeat), written
 //! once per run so results can be drawn and exported again without the scene file.
 
+use crate::contact::obstacle_surface;
 use crate::scene::results::StepResult;
 use crate::scene::World;
 use crate::Real;
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 /// The directions a support holds at one node (several supports of a node combined).
@@ -32,6 +34,20 @@ pub struct ModelBody {
     pub supports: Vec<SupportedNode>,
 }
 
+/// One rigid obstacle of `model.json`: its surface at step 0 and its translation per step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelObstacle {
+    /// Obstacle name (as in the step files' `contacts.with`).
+    pub name: String,
+    /// Surface vertices at step 0, m, `[x, y, z]` (a 2D scene's obstacles are cut by z = 0
+    /// when drawn).
+    pub vertices: Vec<[Real; 3]>,
+    /// Surface triangles as 1-based vertex triples, counter-clockwise seen from outside.
+    pub triangles: Vec<[usize; 3]>,
+    /// Translation at every step 0..=steps, m, `[x, y, z]`.
+    pub offsets: Vec<[Real; 3]>,
+}
+
 /// `model.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ModelFile {
@@ -39,6 +55,58 @@ pub struct ModelFile {
     pub scene: String,
     /// Every body, in scene order (the order of the step files).
     pub bodies: Vec<ModelBody>,
+    /// Every rigid obstacle, in scene order (absent in files of scenes without obstacles and
+    /// of older runs).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub obstacles: Vec<ModelObstacle>,
+}
+
+/// The side of the square a half-space is drawn as, in bounding diagonals of the bodies.
+pub const HALF_SPACE_PATCH: Real = 4.0;
+
+/// The obstacles of `world` as drawn: surfaces at step 0 (a half-space as a square of
+/// [`HALF_SPACE_PATCH`] times the bodies' bounding diagonal, 1 m if that is 0, centred on
+/// the projection of the centroid of the bodies' nodes) and their offsets at every step.
+fn model_obstacles(world: &World) -> Vec<ModelObstacle> {
+    let nodes = world.bodies.iter().flat_map(|b| b.nodes.iter());
+    let mut count = 0usize;
+    let mut sum = Vector3::zeros();
+    let mut lo = Vector3::repeat(Real::INFINITY);
+    let mut hi = Vector3::repeat(Real::NEG_INFINITY);
+    for p in nodes {
+        count += 1;
+        sum += p;
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    let (centroid, diagonal) = if count == 0 {
+        (Vector3::zeros(), 0.0)
+    } else {
+        (sum / count as Real, (hi - lo).norm())
+    };
+    let side = if diagonal > 0.0 && diagonal.is_finite() {
+        HALF_SPACE_PATCH * diagonal
+    } else {
+        1.0
+    };
+    world
+        .obstacles
+        .iter()
+        .map(|o| {
+            let s = obstacle_surface(&o.shape, &centroid, side);
+            ModelObstacle {
+                name: o.name.clone(),
+                vertices: s.vertices.iter().map(|v| [v.x, v.y, v.z]).collect(),
+                triangles: s.triangles.iter().map(|t| t.map(|i| i + 1)).collect(),
+                offsets: (0..=world.steps)
+                    .map(|k| {
+                        let d = o.offset(k, world.steps);
+                        [d.x, d.y, d.z]
+                    })
+                    .collect(),
+            }
+        })
+        .collect()
 }
 
 impl ModelFile {
@@ -88,12 +156,27 @@ impl ModelFile {
         ModelFile {
             scene: world.name.clone(),
             bodies,
+            obstacles: model_obstacles(world),
         }
     }
 
     /// Whether every number in the file refers to something that exists (a torn or edited
     /// file is caught here rather than by an index out of range later). Returns the problem.
     pub fn problem(&self) -> Option<String> {
+        for o in &self.obstacles {
+            let n = o.vertices.len();
+            if let Some(t) = o
+                .triangles
+                .iter()
+                .position(|t| t.iter().any(|&k| k == 0 || k > n))
+            {
+                return Some(format!(
+                    "obstacle '{}': triangle {} names a vertex outside 1..={n}",
+                    o.name,
+                    t + 1
+                ));
+            }
+        }
         for b in &self.bodies {
             let n = b.nodes.len();
             if b.dimension != 2 && b.dimension != 3 {

@@ -8,12 +8,20 @@
 //! `body` (1-based). Cell data: `axial_force` (N), `stress` (Pa), `overloaded` (0/1),
 //! `member` (1-based, 0 on triangles) and `body`. A triangle carries the mean axial force and
 //! stress of those of its three edges that are members (0 if none) and `overloaded` = 0.
+//!
+//! A scene with rigid obstacles also gets `vtk/obstacles_NNNN.vtu` per stored step, part 1 of
+//! the collection: the obstacles' surfaces from `model.json` moved by their offset at that
+//! step, as triangles in 3D and, in 2D, as the segments (VTK_LINE) where they cut z = 0. Cell
+//! data `obstacle`: 1-based, in scene order; field data: one Int32 array per obstacle, named
+//! after it, holding its number.
 
 use crate::atomic_file::write_atomically;
-use crate::scene::model_file::ModelBody;
+use crate::contact::cut_by_z0;
+use crate::scene::model_file::{ModelBody, ModelFile};
 use crate::scene::results::{BodyResult, StepResult};
 use crate::scene::stored_run::{StoredRun, StoredRunError};
 use crate::Real;
+use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -34,9 +42,10 @@ pub enum VtkError {
     },
 }
 
-/// Write `vtk/NNNN.vtu` for every stored step of `run` and `vtk/<scene>.pvd`. The
-/// collection's `timestep` is the load factor when it grows strictly over the stored steps,
-/// else the step number (ParaView needs increasing times). Returns the files written.
+/// Write `vtk/NNNN.vtu` for every stored step of `run` and `vtk/<scene>.pvd`, and with
+/// obstacles `vtk/obstacles_NNNN.vtu` (part 1 of the collection). The collection's
+/// `timestep` is the load factor when it grows strictly over the stored steps, else the step
+/// number (ParaView needs increasing times). Returns the files written.
 pub fn write_vtk(run: &StoredRun) -> Result<Vec<PathBuf>, VtkError> {
     let dir = run.dir.join("vtk");
     std::fs::create_dir_all(&dir).map_err(|source| VtkError::Write {
@@ -58,16 +67,40 @@ pub fn write_vtk(run: &StoredRun) -> Result<Vec<PathBuf>, VtkError> {
         written.push(path);
         entries.push((step, result.load_factor, name));
     }
+    let mut obstacle_files = Vec::new();
+    if !run.model.obstacles.is_empty() {
+        for &step in &run.steps {
+            let text =
+                obstacles_vtu_text(&run.model, step).map_err(|problem| StoredRunError::Bad {
+                    path: run.dir.join("model.json"),
+                    problem,
+                })?;
+            let name = format!("obstacles_{step:04}.vtu");
+            let path = dir.join(&name);
+            write_atomically(&path, text.as_bytes()).map_err(|source| VtkError::Write {
+                path: path.clone(),
+                source,
+            })?;
+            written.push(path);
+            obstacle_files.push(name);
+        }
+    }
     let increasing = entries.windows(2).all(|w| w[1].1 > w[0].1);
     let mut pvd = String::from(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
     );
-    for (step, factor, name) in &entries {
+    for (k, (step, factor, name)) in entries.iter().enumerate() {
         let time = if increasing { *factor } else { *step as Real };
         let _ = writeln!(
             pvd,
             "    <DataSet timestep=\"{time}\" group=\"\" part=\"0\" file=\"{name}\"/>"
         );
+        if let Some(obstacles) = obstacle_files.get(k) {
+            let _ = writeln!(
+                pvd,
+                "    <DataSet timestep=\"{time}\" group=\"\" part=\"1\" file=\"{obstacles}\"/>"
+            );
+        }
     }
     pvd.push_str("  </Collection>\n</VTKFile>\n");
     let path = dir.join(format!("{}.pvd", run.model.scene));
@@ -228,6 +261,115 @@ pub(crate) fn vtu_text(bodies: &[ModelBody], result: &StepResult) -> String {
     s.push_str(
         "\n        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n",
     );
+    s
+}
+
+/// The text of `obstacles_NNNN.vtu` for `step`: every obstacle's surface moved by its
+/// offset at `step`; in a 2D scene (bodies of dimension 2) its cut by z = 0 as lines. Errors
+/// say what in `model.json` does not fit.
+pub(crate) fn obstacles_vtu_text(model: &ModelFile, step: usize) -> Result<String, String> {
+    let two_d = model.bodies.first().is_some_and(|b| b.dimension == 2);
+    let mut points: Vec<[Real; 3]> = Vec::new();
+    let mut cells: Vec<(Vec<usize>, usize)> = Vec::new();
+    for (k, o) in model.obstacles.iter().enumerate() {
+        let d = o.offsets.get(step).ok_or_else(|| {
+            format!(
+                "obstacle '{}' has offsets for steps 0..={} only, not step {step}",
+                o.name,
+                o.offsets.len() as isize - 1
+            )
+        })?;
+        let d = Vector3::from(*d);
+        let vertices: Vec<Vector3<Real>> =
+            o.vertices.iter().map(|v| Vector3::from(*v) + d).collect();
+        let n = vertices.len();
+        if let Some(t) = o
+            .triangles
+            .iter()
+            .find(|t| t.iter().any(|&i| i == 0 || i > n))
+        {
+            return Err(format!(
+                "obstacle '{}': triangle {t:?} names a vertex outside 1..={n}",
+                o.name
+            ));
+        }
+        let triangles: Vec<[usize; 3]> = o.triangles.iter().map(|t| t.map(|i| i - 1)).collect();
+        let base = points.len();
+        if two_d {
+            for [a, b] in cut_by_z0(&vertices, &triangles) {
+                cells.push((vec![points.len(), points.len() + 1], k + 1));
+                points.push([a.x, a.y, a.z]);
+                points.push([b.x, b.y, b.z]);
+            }
+        } else {
+            points.extend(vertices.iter().map(|v| [v.x, v.y, v.z]));
+            cells.extend(
+                triangles
+                    .iter()
+                    .map(|t| (t.iter().map(|i| base + i).collect(), k + 1)),
+            );
+        }
+    }
+    let kind = if two_d { 3 } else { 5 };
+    let mut s = String::with_capacity(64 * (points.len() + cells.len()) + 1024);
+    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n    <FieldData>\n");
+    for (k, o) in model.obstacles.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "      <DataArray type=\"Int32\" Name=\"{}\" NumberOfTuples=\"1\" format=\"ascii\">{}</DataArray>",
+            xml_attribute(&o.name),
+            k + 1
+        );
+    }
+    s.push_str("    </FieldData>\n");
+    let _ = writeln!(
+        s,
+        "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
+        points.len(),
+        cells.len()
+    );
+    s.push_str("      <CellData Scalars=\"obstacle\">\n");
+    ints(&mut s, "obstacle", cells.iter().map(|c| c.1));
+    s.push_str("      </CellData>\n      <Points>\n");
+    vectors(&mut s, "Points", &points);
+    s.push_str("      </Points>\n      <Cells>\n");
+    array_open(&mut s, "Int64", "connectivity", 1);
+    for (c, _) in &cells {
+        for i in c {
+            let _ = write!(s, "{i} ");
+        }
+    }
+    s.push_str("\n        </DataArray>\n");
+    array_open(&mut s, "Int64", "offsets", 1);
+    let mut offset = 0;
+    for (c, _) in &cells {
+        offset += c.len();
+        let _ = write!(s, "{offset} ");
+    }
+    s.push_str("\n        </DataArray>\n");
+    array_open(&mut s, "UInt8", "types", 1);
+    for _ in &cells {
+        let _ = write!(s, "{kind} ");
+    }
+    s.push_str(
+        "\n        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n",
+    );
+    Ok(s)
+}
+
+/// `text` escaped for an XML attribute value.
+fn xml_attribute(text: &str) -> String {
+    let mut s = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => s.push_str("&amp;"),
+            '<' => s.push_str("&lt;"),
+            '>' => s.push_str("&gt;"),
+            '"' => s.push_str("&quot;"),
+            '\'' => s.push_str("&apos;"),
+            c => s.push(c),
+        }
+    }
     s
 }
 
