@@ -18,6 +18,7 @@ use crate::contact::{
     ContactSettings, NodeContact, Obstacle, Obstacles, Penalty, SurfaceProblem, Target,
 };
 use crate::linkage::cholesky::CholeskyError;
+use crate::linkage::line_search::backtrack;
 use crate::linkage::{
     member_response, post_process, prescribed_displacements, Body, DofMap, PathMethod, PhaseTimes,
     SolveError, StepState, StiffnessAssembly,
@@ -877,22 +878,13 @@ impl ContactSolver {
         r0: Real,
     ) -> Real {
         let base: Vec<Vec<Real>> = self.parts.iter().map(|p| p.u.clone()).collect();
-        let mut best = (Real::INFINITY, 1.0);
-        let mut s = 1.0;
-        for _ in 0..5 {
+        let (s, accepted) = backtrack(r0, |s| {
             self.move_free(&base, delta, s);
-            let (r, _) = self.out_of_balance(bodies, set, forces, offsets);
-            let r = norm(&r);
-            if r.is_finite() && r <= (1.0 - 1e-4 * s) * r0 {
-                return s * norm(delta);
-            }
-            if r < best.0 {
-                best = (r, s);
-            }
-            s *= 0.5;
+            norm(&self.out_of_balance(bodies, set, forces, offsets).0)
+        });
+        if !accepted {
+            self.move_free(&base, delta, s);
         }
-        let s = if best.0.is_finite() { best.1 } else { 1.0 };
-        self.move_free(&base, delta, s);
         s * norm(delta)
     }
 

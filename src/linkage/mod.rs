@@ -41,6 +41,7 @@ mod geometry;
 mod iterative_solver;
 mod kinematics;
 pub mod ldlt;
+pub(crate) mod line_search;
 mod material;
 pub(crate) mod mechanism;
 mod member_response;

@@ -7,6 +7,7 @@
 //! Under load control each increment starts from the path extrapolated through the last
 //! converged states when that is closer to equilibrium, which saves the predictor's solve.
 
+use crate::linkage::line_search::backtrack;
 use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::step_state::{force_scale, post_process};
 use crate::linkage::tangent_solver::{TangentError, TangentSolver};
@@ -595,23 +596,13 @@ impl NewtonEquilibrium {
         internal: &mut [Real],
     ) -> Real {
         let base: Vec<Real> = self.dofs.free.iter().map(|&dof| self.u[dof]).collect();
-        let mut best = (Real::INFINITY, 1.0);
-        let mut s = 1.0;
-        for _ in 0..5 {
+        let (s, accepted) = backtrack(r0, |s| {
             self.move_free(&base, delta, s);
-            let r = norm(&self.out_of_balance(body, forces, internal));
-            if r.is_finite() && r <= (1.0 - 1e-4 * s) * r0 {
-                return s * norm(delta);
-            }
-            if r < best.0 {
-                best = (r, s);
-            }
-            s *= 0.5;
+            norm(&self.out_of_balance(body, forces, internal))
+        });
+        if !accepted {
+            self.move_free(&base, delta, s);
         }
-        // No step lowered the residual: take the best (or the full step if all diverged); the
-        // iteration limit decides.
-        let s = if best.0.is_finite() { best.1 } else { 1.0 };
-        self.move_free(&base, delta, s);
         s * norm(delta)
     }
 

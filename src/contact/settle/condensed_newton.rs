@@ -8,6 +8,7 @@ use crate::contact::condensed::{
 };
 use crate::contact::patch_surface::PatchSurface;
 use crate::contact::{penetration_tolerance, ContactError, ContactSet, Obstacles};
+use crate::linkage::line_search::backtrack;
 use crate::linkage::{Body, DofMap, StiffnessAssembly};
 use crate::Real;
 use nalgebra::Vector3;
@@ -643,24 +644,17 @@ impl ContactSolver {
                 }
             }
             let before = self.candidate_displacements();
-            // Backtracking on the residual norm (Armijo, 1e-4): s = 1, 1/2, … 1/16.
-            let mut best = (Real::INFINITY, 1.0);
-            let mut s = 1.0;
-            for _ in 0..5 {
+            // The residual of the accepted trial is the next iteration's: kept, not recomputed.
+            let mut last = None;
+            let (s, accepted) = backtrack(rnorm, |s| {
                 self.apply_correction(&base, &corr, s);
-                let trial = self.condensed_residual(bodies, set, forces, offsets);
-                let r = trial.as_ref().map_or(Real::INFINITY, |e| e.2);
-                if r.is_finite() && r <= (1.0 - 1e-4 * s) * rnorm {
-                    pending = trial.ok();
-                    break;
-                }
-                if r < best.0 {
-                    best = (r, s);
-                }
-                s *= 0.5;
-            }
-            if pending.is_none() {
-                self.apply_correction(&base, &corr, best.1);
+                last = self.condensed_residual(bodies, set, forces, offsets).ok();
+                last.as_ref().map_or(Real::INFINITY, |e| e.2)
+            });
+            if accepted {
+                pending = last;
+            } else {
+                self.apply_correction(&base, &corr, s);
                 self.place_condensed();
             }
             last_step = before
