@@ -38,8 +38,8 @@ pub type Real = f64;
 
 pub mod atomic_file;
 pub mod bench;
-pub mod bench_large;
 pub mod contact;
+pub mod linalg;
 pub mod linkage;
 pub mod render;
 pub mod scene;

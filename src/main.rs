@@ -350,7 +350,7 @@ fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
 }
 
 fn export(scene: &Path, out: &Path) -> Result<()> {
-    use linkage::linkage::paper_files::{write_links, write_nodes, write_patches};
+    use linkage::scene::paper_files::{write_links, write_nodes, write_patches};
     let world = load_scene(scene)?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create the output folder {}", out.display()))?;
@@ -410,12 +410,12 @@ fn bench_large(
         (true, true) => "multigrid conjugate gradients, cold starts",
     };
     println!("3D column lattice, bottom clamped, top pushed sideways; large displacements by Newton ({how})");
-    let t = linkage::bench_large::measure_large(cells, force, steps, solver)
+    let t = linkage::bench::large::measure_large(cells, force, steps, solver)
         .map_err(anyhow::Error::msg)?;
     for s in &t.steps {
-        println!("{}", linkage::bench_large::format_step(s));
+        println!("{}", linkage::bench::large::format_step(s));
     }
-    println!("{}", linkage::bench_large::format_summary(&t));
+    println!("{}", linkage::bench::large::format_summary(&t));
     Ok(())
 }
 
@@ -443,17 +443,18 @@ fn bench(cells: Vec<[usize; 3]>, iterative: bool, jacobi: bool, in_process: bool
     };
     println!("3D box lattices: 26-neighbour cells, bottom face fixed, top face loaded; {what}");
     if iterative {
-        println!("{}", linkage::bench::ITERATIVE_HEADER);
+        println!("{}", linkage::bench::lattice::ITERATIVE_HEADER);
     } else {
-        println!("{}", linkage::bench::HEADER);
+        println!("{}", linkage::bench::lattice::HEADER);
     }
     for c in sizes {
         if in_process && iterative {
-            let t = linkage::bench::measure_iterative(c, !jacobi).map_err(anyhow::Error::msg)?;
-            println!("{}", linkage::bench::format_iterative_row(&t));
+            let t = linkage::bench::lattice::measure_iterative(c, !jacobi)
+                .map_err(anyhow::Error::msg)?;
+            println!("{}", linkage::bench::lattice::format_iterative_row(&t));
         } else if in_process {
-            let t = linkage::bench::measure_lattice(c).map_err(anyhow::Error::msg)?;
-            println!("{}", linkage::bench::format_row(&t));
+            let t = linkage::bench::lattice::measure_lattice(c).map_err(anyhow::Error::msg)?;
+            println!("{}", linkage::bench::lattice::format_row(&t));
         } else {
             // One child per size, so the peak memory column is that size's own.
             let exe = std::env::current_exe().context("cannot find the linkage executable")?;
@@ -544,7 +545,7 @@ fn render(a: &RenderArgs) -> Result<()> {
 }
 
 fn bench_render(patches: usize, size: [u32; 2]) -> Result<()> {
-    let t = linkage::render::render_benchmark(patches, size[0], size[1], 3)
+    let t = linkage::bench::render::render_benchmark(patches, size[0], size[1], 3)
         .map_err(anyhow::Error::msg)?;
     println!("Rendering: one frame of a bent cylindrical shell, shaded and stress-coloured (supersampling 2x2), best of 3");
     println!(

@@ -2,7 +2,7 @@
 //! answers, warm starts that save iterations, mechanisms still named, and a fallback when
 //! conjugate gradients cannot reach their tolerance.
 
-use linkage::bench::lattice_body;
+use linkage::linkage::generators::lattice_body;
 use linkage::linkage::{Body, BodySolver, Kinematics, SolverChoice};
 use linkage::scene::{load_scene, Simulation, World};
 use std::path::Path;

@@ -15,7 +15,7 @@
 //! problem of the size of the active contacts (see [`contact_newton_step`]); the whole
 //! displacement field costs one solve per body per load step ([`CondensedBody::expand`]).
 
-use crate::linkage::cholesky::{CholeskyError, SparseCholesky};
+use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
 use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::rigid_modes::{free_rigid_modes, pinned_dofs_avoiding};
 use crate::linkage::Mechanism;

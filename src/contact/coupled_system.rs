@@ -2,7 +2,7 @@
 //! diagonal (its pattern computed once by [`StiffnessAssembly`]), plus the penalty blocks of
 //! the active contacts, factored together.
 
-use crate::linkage::cholesky::{CholeskyError, SparseCholesky};
+use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
 use crate::linkage::StiffnessAssembly;
 use crate::Real;
 

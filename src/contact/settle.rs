@@ -17,7 +17,7 @@ use crate::contact::{
     default_penalty, penetration_tolerance, ActiveContact, ContactError, ContactSet,
     ContactSettings, NodeContact, Obstacle, Obstacles, Penalty, SurfaceProblem, Target,
 };
-use crate::linkage::cholesky::CholeskyError;
+use crate::linalg::cholesky::CholeskyError;
 use crate::linkage::line_search::backtrack;
 use crate::linkage::{
     member_response, post_process, prescribed_displacements, Body, DofMap, PathMethod, PhaseTimes,

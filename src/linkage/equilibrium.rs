@@ -1,5 +1,5 @@
+use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
 use crate::linkage::assembly::ModelTooLarge;
-use crate::linkage::cholesky::{CholeskyError, SparseCholesky};
 use crate::linkage::iterative_solver::IterativeSolver;
 use crate::linkage::mechanism::{diagnose_mechanism, Mechanism};
 use crate::linkage::step_state::post_process;

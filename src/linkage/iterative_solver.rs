@@ -2,10 +2,11 @@
 //! the pattern in full rows is built once, the values refilled, the hierarchy rebuilt only when
 //! the matrix has drifted far enough that the iterations grow, every solve warm-started.
 
-use crate::linkage::{
-    conjugate_gradient, dot, CgReport, CgSettings, DofMap, IterativeSettings, MultigridError,
-    SmoothedAggregation, StiffnessAssembly, SymmetricCsr,
+use crate::linalg::{
+    conjugate_gradient, dot, CgReport, CgSettings, MultigridError, SmoothedAggregation,
+    SymmetricCsr,
 };
+use crate::linkage::{DofMap, IterativeSettings, StiffnessAssembly};
 use crate::Real;
 use nalgebra::Vector3;
 

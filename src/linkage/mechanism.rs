@@ -1,7 +1,7 @@
 //! Naming the nodes of a mechanism: when `K_ff` is singular, find a displacement mode that
 //! stretches no member and report which nodes it moves, in which directions.
 
-use crate::linkage::cholesky::SparseCholesky;
+use crate::linalg::cholesky::SparseCholesky;
 use crate::linkage::{direction_name, Body, DofMap, StiffnessAssembly};
 use crate::Real;
 use nalgebra::{DMatrix, DVector, Vector3};

@@ -3,13 +3,11 @@
 
 pub use self::assembly::ModelTooLarge;
 pub use self::assembly::StiffnessAssembly;
-pub use self::block_jacobi::{BlockJacobi, SingularBlock};
 pub use self::body::{
     bounding_diagonal, check_members, prescribed_displacements, Body, BodyError, Dimension, Member,
     MemberProblem, NodalLoad, Schedule, Support,
 };
 pub use self::body_solver::BodySolver;
-pub use self::conjugate_gradient::{conjugate_gradient, CgReport, CgSettings};
 pub use self::dof_map::{direction_name, DofMap, DofSlot};
 pub use self::equilibrium::{Equilibrium, PhaseTimes, SolveError};
 pub use self::geometry::Geometry;
@@ -19,41 +17,30 @@ pub use self::mechanism::Mechanism;
 pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
 pub use self::newton::NewtonEquilibrium;
-pub use self::smoothed_aggregation::{MultigridError, SmoothedAggregation};
 pub use self::solver_choice::{
     IterativeSettings, SolverChoice, SolverSettings, AUTO_ITERATIVE_DOFS_2D, AUTO_ITERATIVE_DOFS_3D,
 };
 pub(crate) use self::step_state::post_process;
 pub use self::step_state::StepState;
-pub use self::symmetric_csr::{dot, Preconditioner, SymmetricCsr};
 
 mod assembly;
-mod block_jacobi;
-pub(crate) mod block_matrix;
 mod body;
 mod body_solver;
-pub mod cholesky;
-mod conjugate_gradient;
 mod dof_map;
 mod equilibrium;
 pub mod generators;
 mod geometry;
 mod iterative_solver;
 mod kinematics;
-pub mod ldlt;
 pub(crate) mod line_search;
 mod material;
 pub(crate) mod mechanism;
 mod member_response;
 mod member_stiffness;
 mod newton;
-pub mod ordering;
-pub mod paper_files;
 pub mod rigid_modes;
-mod smoothed_aggregation;
 mod solver_choice;
 mod step_state;
-mod symmetric_csr;
 mod tangent_solver;
 #[cfg(test)]
 mod test_lattice;

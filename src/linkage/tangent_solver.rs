@@ -5,9 +5,9 @@
 //! A large body may instead be solved by multigrid conjugate gradients, warm-started, with the
 //! direct factorization as the fallback when they do not converge.
 
-use crate::linkage::cholesky::{CholeskyError, SparseCholesky};
+use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
+use crate::linalg::ldlt::SparseLdlt;
 use crate::linkage::iterative_solver::IterativeSolver;
-use crate::linkage::ldlt::SparseLdlt;
 use crate::linkage::{Body, DofMap, StiffnessAssembly};
 use crate::Real;
 

@@ -1,6 +1,5 @@
 //! Pictures of stored results: PNG frames and a GIF of a run, 2D line art and shaded 3D patches.
 
-pub use self::bench::{bent_shell, render_benchmark, RenderTiming};
 pub use self::camera::{Camera, View, FIELD_OF_VIEW};
 pub use self::colour_scale::{colour_at, format_si, ColourScale, Rgb};
 pub use self::error::RenderError;
@@ -13,7 +12,6 @@ pub use self::primitives::{paint, Layer, Mesh, Primitive};
 pub use self::raster::{Lighting, RasterVertex, Rasteriser};
 pub use self::run_pictures::{render_run, select_steps, PictureWriter, RenderReport};
 
-mod bench;
 mod camera;
 mod colour_scale;
 mod deformed_body;

@@ -2,12 +2,12 @@
 
 use crate::contact::Obstacle;
 use crate::linkage::generators;
-use crate::linkage::paper_files::{self, PaperFileError};
 use crate::linkage::{
     Behaviour, Body, Dimension, Geometry, Kinematics, Material, Member, NewtonSettings, NodalLoad,
     PathMethod, Schedule, SolverChoice, SolverSettings, Support,
 };
 use crate::scene::obstacles::{contact_settings, obstacle_from};
+use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
 use crate::scene::{OutputSettings, PictureSettings, World};

@@ -19,6 +19,7 @@ mod extra_outputs;
 mod mesh_file;
 mod model_file;
 mod obstacles;
+pub mod paper_files;
 mod pictures;
 mod results;
 mod selector;

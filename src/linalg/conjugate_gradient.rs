@@ -1,9 +1,16 @@
 //! Preconditioned conjugate gradients for `K_ff U_f = F_f` (paper Eq. 8) on bodies too large to
 //! factor, warm-started from the best guess at hand.
 
-use crate::linkage::{dot, Preconditioner, SymmetricCsr};
+use crate::linalg::{dot, SymmetricCsr};
 use crate::Real;
 use rayon::prelude::*;
+
+/// An approximate inverse of a symmetric positive definite matrix, applied once per
+/// conjugate-gradient iteration.
+pub trait Preconditioner {
+    /// `z = M⁻¹ r` for the matrix `a`.
+    fn apply(&mut self, a: &SymmetricCsr, r: &[Real], z: &mut [Real]);
+}
 
 /// When conjugate gradients stop.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -117,83 +124,4 @@ pub fn conjugate_gradient(
     report.converged =
         !report.breakdown && report.residual.is_finite() && report.residual <= settings.tolerance;
     report
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::linkage::cholesky::SparseCholesky;
-    use crate::linkage::test_lattice::lattice_system;
-    use crate::linkage::{BlockJacobi, StiffnessAssembly};
-
-    /// `K_ff` of a small lattice with its bottom fixed, as assembly, values and full rows.
-    fn lattice() -> (StiffnessAssembly, Vec<Real>, SymmetricCsr) {
-        let s = lattice_system([4, 3, 5]);
-        (s.assembly, s.values, s.matrix)
-    }
-
-    #[test]
-    fn agrees_with_the_direct_solve_and_warm_starts_help() {
-        let (asm, values, csr) = lattice();
-        let b: Vec<Real> = (0..asm.n)
-            .map(|i| ((i * 7919) % 13) as Real - 6.0)
-            .collect();
-        let mut direct = b.clone();
-        let mut chol =
-            SparseCholesky::analyze(asm.n, &asm.col_ptr, &asm.row_idx, Some(&asm.groups)).unwrap();
-        chol.factorize(&values).unwrap();
-        chol.solve_in_place(&mut direct);
-        let mut m = BlockJacobi::new(&csr, &asm.groups).unwrap();
-        let mut x = vec![0.0; asm.n];
-        let cold = conjugate_gradient(&csr, &mut m, &b, &mut x, CgSettings::default());
-        assert!(cold.converged && cold.residual <= 1e-10, "{cold:?}");
-        let scale = direct.iter().map(|v| v.abs()).fold(0.0, Real::max);
-        let err = x
-            .iter()
-            .zip(&direct)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, Real::max);
-        assert!(
-            err <= 1e-8 * scale,
-            "iterative and direct differ by {err:e} of {scale:e}"
-        );
-        // A nearby right-hand side from the previous answer needs fewer iterations.
-        let b2: Vec<Real> = b.iter().map(|v| 1.1 * v).collect();
-        let mut warm: Vec<Real> = x.iter().map(|v| 1.05 * v).collect();
-        let warm_report = conjugate_gradient(&csr, &mut m, &b2, &mut warm, CgSettings::default());
-        assert!(warm_report.converged);
-        assert!(
-            warm_report.iterations < cold.iterations,
-            "{} vs {}",
-            warm_report.iterations,
-            cold.iterations
-        );
-        // Thread count does not change the answer: one thread gives the same bits.
-        let mut one = vec![0.0; asm.n];
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap();
-        let single =
-            pool.install(|| conjugate_gradient(&csr, &mut m, &b, &mut one, CgSettings::default()));
-        assert_eq!(single.iterations, cold.iterations);
-        assert_eq!(one, x);
-    }
-
-    #[test]
-    fn an_unreachable_tolerance_is_reported_not_hidden() {
-        let (asm, _, csr) = lattice();
-        let b = vec![1.0; asm.n];
-        let mut m = BlockJacobi::new(&csr, &asm.groups).unwrap();
-        let mut x = vec![0.0; asm.n];
-        let settings = CgSettings {
-            tolerance: 1e-30,
-            max_iterations: 50,
-            reference_norm: 0.0,
-        };
-        let r = conjugate_gradient(&csr, &mut m, &b, &mut x, settings);
-        assert!(!r.converged);
-        assert_eq!(r.iterations, 50);
-        assert!(r.residual.is_finite() && r.residual > 1e-30);
-    }
 }

@@ -191,13 +191,6 @@ fn row_times(col: &[u32], val: &[Real], x: &[Real]) -> Real {
     sum
 }
 
-/// An approximate inverse of a symmetric positive definite matrix, applied once per
-/// conjugate-gradient iteration.
-pub trait Preconditioner {
-    /// `z = M⁻¹ r` for the matrix `a`.
-    fn apply(&mut self, a: &SymmetricCsr, r: &[Real], z: &mut [Real]);
-}
-
 /// `Σ a_i b_i`, summed in fixed chunks whose partial sums are added in order: the same
 /// result whatever the number of threads.
 pub fn dot(a: &[Real], b: &[Real]) -> Real {

@@ -4,7 +4,7 @@
 //! product reads about a third of the memory of the full-row `f64` matrix; products accumulate
 //! in `f64`.
 
-use crate::linkage::SymmetricCsr;
+use crate::linalg::SymmetricCsr;
 use crate::Real;
 use rayon::prelude::*;
 
@@ -178,38 +178,4 @@ fn block_times<const B: usize>(block: &[[f32; B]; B], x: &[Real; B]) -> [Real; B
         *ta = s;
     }
     t
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::linkage::test_lattice::lattice_system;
-
-    #[test]
-    fn block_products_match_the_full_rows_to_single_precision() {
-        let s = lattice_system([4, 3, 5]);
-        let a = &s.matrix;
-        let blocks = BlockMatrix::<3>::from_full_rows(a).expect("node blocks of 3");
-        assert_eq!(3 * blocks.blocks, a.n);
-        let x: Vec<Real> = (0..a.n).map(|i| (i as Real * 0.37).sin()).collect();
-        let mut exact = vec![0.0; a.n];
-        a.multiply(&x, &mut exact);
-        let mut y = vec![0.0; a.n];
-        blocks.multiply(&x, &mut y);
-        let scale = exact.iter().map(|v| v.abs()).fold(0.0, Real::max);
-        let diagonal_scale = a.diagonal().iter().copied().fold(0.0, Real::max);
-        for (p, q) in y.iter().zip(&exact) {
-            // Each of 81 products carries a relative error of 2⁻²⁴ of its entry.
-            assert!((p - q).abs() <= 81.0 * 6e-8 * diagonal_scale, "{p} vs {q}");
-        }
-        assert!(scale > 0.0);
-        let b: Vec<Real> = (0..a.n).map(|i| i as Real).collect();
-        let mut r = vec![0.0; a.n];
-        blocks.residual(&b, &x, &mut r);
-        for i in 0..a.n {
-            assert_eq!(r[i], b[i] - y[i]);
-        }
-        // Not made of aligned 2×2 blocks (a node has 3 DOFs): refused.
-        assert!(BlockMatrix::<2>::from_full_rows(a).is_none());
-    }
 }

@@ -1,8 +1,8 @@
 //! `linkage bench`: the phases of the linear solve on 3D box lattices of growing size.
 
-use crate::linkage::{generators, Body, Equilibrium, Material, NodalLoad, Schedule, Support};
+use crate::linkage::generators::lattice_body;
+use crate::linkage::Equilibrium;
 use crate::Real;
-use nalgebra::Vector3;
 use std::time::Instant;
 
 /// One measured lattice.
@@ -36,50 +36,10 @@ pub struct LatticeTiming {
     pub peak_memory: u64,
 }
 
-/// A steel lattice of `cells` unit cells (0.01 m each, members of 1 mm²), bottom face fixed,
-/// the top face pushed down and sideways by 1 kN in total.
-pub fn lattice_body(cells: [usize; 3]) -> Result<Body, String> {
-    loaded_lattice("lattice", cells, Vector3::new(200.0, 0.0, -1000.0))
-}
-
-/// A steel lattice of `cells` unit cells (0.01 m each, members of 1 mm²) named `name`, its
-/// bottom face clamped, `total_force` (N) shared by the nodes of its top face.
-pub fn loaded_lattice(
-    name: &str,
-    cells: [usize; 3],
-    total_force: Vector3<Real>,
-) -> Result<Body, String> {
-    let h = 0.01;
-    let size = [
-        cells[0] as Real * h,
-        cells[1] as Real * h,
-        cells[2] as Real * h,
-    ];
-    let geometry = generators::box_lattice(size, cells).map_err(|e| e.to_string())?;
-    let mut body = Body::from_geometry(name, geometry, Material::new("steel", 200e9, 1e-6));
-    let top: Vec<usize> = (0..body.nodes.len())
-        .filter(|&i| (body.nodes[i].z - size[2]).abs() < 1e-9)
-        .collect();
-    for i in 0..body.nodes.len() {
-        if body.nodes[i].z.abs() < 1e-9 {
-            body.supports.push(Support::fixed(i, [true, true, true]));
-        }
-    }
-    let per_node = total_force / top.len() as Real;
-    for i in top {
-        body.loads.push(NodalLoad {
-            node: i,
-            force: per_node,
-            schedule: Schedule::Linear,
-        });
-    }
-    Ok(body)
-}
-
 /// Generate, assemble, factor and solve one lattice, timing each phase.
 pub fn measure_lattice(cells: [usize; 3]) -> Result<LatticeTiming, String> {
     let t = Instant::now();
-    let mut body = lattice_body(cells)?;
+    let mut body = lattice_body(cells).map_err(|e| e.to_string())?;
     body.solver.choice = crate::linkage::SolverChoice::Direct;
     let generate = t.elapsed().as_secs_f64();
     let eq = Equilibrium::new(&body).map_err(|e| e.to_string())?;
@@ -166,11 +126,12 @@ pub struct IterativeTiming {
 /// Assemble a lattice and solve it with conjugate gradients preconditioned by smoothed
 /// aggregation (`multigrid`) or block Jacobi, timing each phase.
 pub fn measure_iterative(cells: [usize; 3], multigrid: bool) -> Result<IterativeTiming, String> {
-    use crate::linkage::{
-        axial_stiffness, conjugate_gradient, BlockJacobi, CgSettings, DofMap, Preconditioner,
-        SmoothedAggregation, StiffnessAssembly, SymmetricCsr,
+    use crate::linalg::{
+        conjugate_gradient, BlockJacobi, CgSettings, Preconditioner, SmoothedAggregation,
+        SymmetricCsr,
     };
-    let body = lattice_body(cells)?;
+    use crate::linkage::{axial_stiffness, DofMap, StiffnessAssembly};
+    let body = lattice_body(cells).map_err(|e| e.to_string())?;
     let t = Instant::now();
     let dofs = DofMap::new(&body);
     let asm = StiffnessAssembly::new(&body, &dofs).map_err(|e| e.to_string())?;

@@ -1,3 +1,5 @@
+//! `linkage bench --render`: the time to draw one frame of a shaded, bent cylindrical shell.
+
 use crate::linkage::generators::cylindrical_shell;
 use crate::render::{draw_frame, RenderOptions, RunExtent};
 use crate::scene::{BodyResult, ModelBody, ModelFile, NodeForce, StepResult, SupportedNode};

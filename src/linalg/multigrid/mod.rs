@@ -14,9 +14,9 @@
 //! `A` in double precision. The copy is taken when the hierarchy is built: a hierarchy kept
 //! for a refilled matrix smooths with the values it was built for.
 
-use crate::linkage::block_matrix::{BlockMatrix, BLOCK_ROWS_PER_TASK};
-use crate::linkage::cholesky::SparseCholesky;
-use crate::linkage::{dot, Preconditioner, SymmetricCsr};
+use crate::linalg::block_matrix::{BlockMatrix, BLOCK_ROWS_PER_TASK};
+use crate::linalg::cholesky::SparseCholesky;
+use crate::linalg::{dot, Preconditioner, SymmetricCsr};
 use crate::Real;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -1079,85 +1079,5 @@ impl Preconditioner for SmoothedAggregation {
     /// `z = M⁻¹ r`: one V-cycle from a zero guess.
     fn apply(&mut self, fine: &SymmetricCsr, r: &[Real], z: &mut [Real]) {
         self.cycle(0, fine, r, z);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::linkage::test_lattice::{lattice_system, LatticeSystem};
-    use crate::linkage::{conjugate_gradient, BlockJacobi, CgSettings};
-
-    #[test]
-    fn multigrid_cg_matches_the_direct_solve_in_far_fewer_iterations() {
-        let LatticeSystem {
-            matrix: csr,
-            assembly: asm,
-            values,
-            directions,
-            body,
-        } = lattice_system([8, 8, 10]);
-        let b: Vec<Real> = (0..asm.n)
-            .map(|i| ((i * 7919) % 13) as Real - 6.0)
-            .collect();
-        let mut direct = b.clone();
-        let mut chol =
-            SparseCholesky::analyze(asm.n, &asm.col_ptr, &asm.row_idx, Some(&asm.groups)).unwrap();
-        chol.factorize(&values).unwrap();
-        chol.solve_in_place(&mut direct);
-
-        // Three levels at least: a small coarse size forces recursion.
-        let mut amg = SmoothedAggregation::with_coarse_size(
-            &csr,
-            &asm.groups,
-            &directions,
-            &body.nodes,
-            3,
-            200,
-        )
-        .unwrap();
-        assert!(amg.sizes.len() >= 3, "{:?}", amg.sizes);
-        let mut x = vec![0.0; asm.n];
-        let report = conjugate_gradient(&csr, &mut amg, &b, &mut x, CgSettings::default());
-        assert!(report.converged && report.residual <= 1e-10, "{report:?}");
-        let scale = direct.iter().map(|v| v.abs()).fold(0.0, Real::max);
-        let err = x
-            .iter()
-            .zip(&direct)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, Real::max);
-        assert!(err <= 1e-8 * scale, "{err:e} of {scale:e}");
-
-        // Built and applied on one thread, the hierarchy gives the same bits.
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap();
-        let (single, one) = pool.install(|| {
-            let mut amg = SmoothedAggregation::with_coarse_size(
-                &csr,
-                &asm.groups,
-                &directions,
-                &body.nodes,
-                3,
-                200,
-            )
-            .unwrap();
-            let mut one = vec![0.0; asm.n];
-            let r = conjugate_gradient(&csr, &mut amg, &b, &mut one, CgSettings::default());
-            (r, one)
-        });
-        assert_eq!(single.iterations, report.iterations);
-        assert_eq!(one, x);
-
-        let mut jacobi = BlockJacobi::new(&csr, &asm.groups).unwrap();
-        let mut y = vec![0.0; asm.n];
-        let plain = conjugate_gradient(&csr, &mut jacobi, &b, &mut y, CgSettings::default());
-        assert!(
-            report.iterations * 4 < plain.iterations,
-            "multigrid {} vs block-Jacobi {} iterations",
-            report.iterations,
-            plain.iterations
-        );
     }
 }

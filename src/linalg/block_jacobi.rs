@@ -1,6 +1,6 @@
 //! The block-Jacobi preconditioner: the inverse of each node's 2×2 or 3×3 diagonal block.
 
-use crate::linkage::{Preconditioner, SymmetricCsr};
+use crate::linalg::{Preconditioner, SymmetricCsr};
 use crate::Real;
 use nalgebra::{DMatrix, Matrix3};
 use rayon::prelude::*;

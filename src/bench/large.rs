@@ -2,7 +2,8 @@
 //! large-displacement solve on a slender 3D box lattice bent far by a side load, against the
 //! linear solve of the same body (see `docs/PERFORMANCE.md`, "Large displacements").
 
-use crate::bench::{loaded_lattice, peak_memory};
+use crate::bench::lattice::peak_memory;
+use crate::linkage::generators::loaded_lattice;
 use crate::linkage::{Body, Equilibrium, Kinematics, NewtonEquilibrium, SolverSettings};
 use crate::Real;
 use nalgebra::Vector3;
@@ -11,7 +12,7 @@ use std::time::Instant;
 /// A steel column of `cells` unit cells (0.01 m each, members of 1 mm²), its bottom face
 /// clamped, its top face pushed sideways (+x) by `force` N in total.
 pub fn column_body(cells: [usize; 3], force: Real) -> Result<Body, String> {
-    loaded_lattice("column", cells, Vector3::new(force, 0.0, 0.0))
+    loaded_lattice("column", cells, Vector3::new(force, 0.0, 0.0)).map_err(|e| e.to_string())
 }
 
 /// One load step of the large-displacement solve.

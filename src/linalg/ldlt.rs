@@ -7,7 +7,7 @@
 //!
 //! No pivoting: a pivot that is exactly zero (a singular tangent, a mechanism) is an error.
 
-use crate::linkage::cholesky::{factor_diagonal_positions, CholeskyError, SparseCholesky};
+use crate::linalg::cholesky::{factor_diagonal_positions, CholeskyError, SparseCholesky};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
 use faer::perm::PermRef;
