@@ -9,7 +9,7 @@ use rayon::prelude::*;
 const ROWS_PER_TASK: usize = 2048;
 
 /// A symmetric matrix stored in full compressed rows (both triangles), built from the
-/// lower-triangle compressed columns of [`crate::linkage::StiffnessAssembly`]. Its pattern is
+/// lower-triangle compressed columns of a stiffness assembly. Its pattern is
 /// built once; `refill` copies new values through a stored map.
 #[derive(Clone, Debug)]
 pub struct SymmetricCsr {
