@@ -16,6 +16,7 @@
 //! displacement field costs one solve per body per load step ([`CondensedBody::expand`]).
 
 use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
+use crate::linkage::body_state::tangent_times;
 use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::rigid_modes::{free_rigid_modes, pinned_dofs_avoiding};
 use crate::linkage::Mechanism;
@@ -265,7 +266,9 @@ impl CondensedBody {
                 }
             }
             let u_s = prescribed_displacements(body, |s| Real::from(u8::from(*s == schedule)));
-            let pull = linear_internal_forces(body, d, &u_s);
+            // `K u_s` with the linear stiffness: the linear tangent at the undeformed state.
+            let mut pull = vec![0.0; body.dof_count()];
+            tangent_times(body, &vec![0.0; body.dof_count()], &u_s, &mut pull);
             let load: Vec<Real> = dofs.free.iter().map(|&f| full[f] - pull[f]).collect();
             let x = condensed.solve(&load);
             let base = condensed.cand.iter().map(|&i| x[i]).collect();
@@ -397,25 +400,6 @@ fn linear_block(body: &Body, m: usize) -> nalgebra::Matrix3<Real> {
         &body.nodes[b],
         material.youngs_modulus * material.area / body.member_length(m),
     )
-}
-
-/// `K u` per body DOF for the linear stiffness, N.
-fn linear_internal_forces(body: &Body, d: usize, u: &[Real]) -> Vec<Real> {
-    let mut out = vec![0.0; body.dof_count()];
-    for (m, member) in body.members.iter().enumerate() {
-        let [a, b] = member.nodes;
-        let k = linear_block(body, m);
-        let mut du = nalgebra::Vector3::zeros();
-        for i in 0..d {
-            du[i] = u[b * d + i] - u[a * d + i];
-        }
-        let f = k * du;
-        for i in 0..d {
-            out[a * d + i] -= f[i];
-            out[b * d + i] += f[i];
-        }
-    }
-    out
 }
 
 /// `(L Lᵀ)⁻¹` for a dense lower-triangular `L`, full and column-major.

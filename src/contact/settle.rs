@@ -18,10 +18,13 @@ use crate::contact::{
     ContactSettings, NodeContact, Obstacle, Obstacles, Penalty, SurfaceProblem, Target,
 };
 use crate::linalg::cholesky::CholeskyError;
+use crate::linkage::body_state::{
+    fill_tangent, internal_force_vector, loads_at, member_response_at, node_vector, norm,
+    prescribed_at,
+};
 use crate::linkage::line_search::backtrack;
 use crate::linkage::{
-    member_response, post_process, prescribed_displacements, Body, DofMap, PathMethod, PhaseTimes,
-    SolveError, StepState, StiffnessAssembly,
+    post_process, Body, DofMap, PathMethod, PhaseTimes, SolveError, StepState, StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
@@ -362,9 +365,12 @@ impl ContactSolver {
         self.condensed_step(step, steps, restart);
         self.step = step;
         let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset(step, steps)).collect();
-        let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, step, steps)).collect();
+        let forces: Vec<Vec<Real>> = bodies
+            .iter()
+            .map(|b| loads_at(b, step as Real, steps))
+            .collect();
         for (part, body) in self.parts.iter_mut().zip(bodies) {
-            let prescribed = prescribed_at(body, step, steps);
+            let prescribed = prescribed_at(body, step as Real, steps);
             for &dof in &part.dofs.supported {
                 part.u[dof] = prescribed[dof];
             }
@@ -625,7 +631,7 @@ impl ContactSolver {
         let (all, _) = self.contact_forces(bodies, set, offsets);
         for ((b, body), fc) in bodies.iter().enumerate().zip(all) {
             let part = &self.parts[b];
-            let internal = internal_forces(body, part.dofs.dofs_per_node, &part.u);
+            let internal = internal_force_vector(body, &part.u);
             let offset = self.system.offsets[b];
             for (i, &dof) in part.dofs.free.iter().enumerate() {
                 r[offset + i] = forces[b][dof] + fc[dof] - internal[dof];
@@ -743,10 +749,7 @@ impl ContactSolver {
         let t = Instant::now();
         self.couple(bodies, set, offsets)?;
         for (part, body) in self.parts.iter_mut().zip(bodies) {
-            let d = part.dofs.dofs_per_node;
-            let u = &part.u;
-            part.assembly
-                .fill(body, |m| member_tangent(body, d, u, m), &mut part.local);
+            fill_tangent(body, &part.assembly, &part.u, &mut part.local);
         }
         let locals: Vec<Vec<Real>> = self
             .parts
@@ -1246,12 +1249,12 @@ impl ContactSolver {
         for ((b, body), fc) in bodies.iter().enumerate().zip(all) {
             let part = &self.parts[b];
             let d = part.dofs.dofs_per_node;
-            let mut internal = internal_forces(body, d, &part.u);
+            let mut internal = internal_force_vector(body, &part.u);
             for (i, f) in internal.iter_mut().zip(&fc) {
                 *i -= f;
             }
             let members = (0..body.members.len()).map(|m| {
-                let r = response(body, d, &part.u, m);
+                let r = member_response_at(body, &part.u, m);
                 (r.strain, r.force)
             });
             let mut state = post_process(body, &part.dofs, &part.u, &forces[b], &internal, members);
@@ -1313,63 +1316,6 @@ impl ContactSolver {
     }
 }
 
-fn node_vector(u: &[Real], d: usize, node: usize) -> Vector3<Real> {
-    let mut v = Vector3::zeros();
-    for k in 0..d {
-        v[k] = u[node * d + k];
-    }
-    v
-}
-
-fn response(body: &Body, d: usize, u: &[Real], m: usize) -> crate::linkage::MemberResponse {
-    let member = body.members[m];
-    let [a, b] = member.nodes;
-    member_response(
-        body.kinematics,
-        &body.materials[member.material],
-        &body.nodes[a],
-        &body.nodes[b],
-        &node_vector(u, d, a),
-        &node_vector(u, d, b),
-    )
-}
-
-fn member_tangent(body: &Body, d: usize, u: &[Real], m: usize) -> nalgebra::Matrix3<Real> {
-    response(body, d, u, m).tangent
-}
-
-/// Member forces per body DOF at `u`, N: member m pushes its ends with `∓N n`.
-fn internal_forces(body: &Body, d: usize, u: &[Real]) -> Vec<Real> {
-    let mut out = vec![0.0; body.dof_count()];
-    for m in 0..body.members.len() {
-        let r = response(body, d, u, m);
-        let [a, b] = body.members[m].nodes;
-        for k in 0..d {
-            out[a * d + k] -= r.force * r.axis[k];
-            out[b * d + k] += r.force * r.axis[k];
-        }
-    }
-    out
-}
-
-/// Applied force per body DOF at `step` of `steps`, N.
-fn loads_at(body: &Body, step: usize, steps: usize) -> Vec<Real> {
-    let d = body.dimension.dofs_per_node();
-    let mut f = vec![0.0; body.dof_count()];
-    for l in &body.loads {
-        let factor = l.schedule.factor(step, steps);
-        for k in 0..d {
-            f[l.node * d + k] += factor * l.force[k];
-        }
-    }
-    f
-}
-
-/// Prescribed displacement per body DOF at `step`, m (see [`prescribed_displacements`]).
-fn prescribed_at(body: &Body, step: usize, steps: usize) -> Vec<Real> {
-    prescribed_displacements(body, |schedule| schedule.factor(step, steps))
-}
-
 /// The Newton tolerance of a contact scene (the smallest of the bodies', at most 1e-10) and the
 /// iterations allowed per contact set (the largest of the bodies').
 fn newton_limits(bodies: &[Body]) -> (Real, usize) {
@@ -1384,8 +1330,4 @@ fn newton_limits(bodies: &[Body]) -> (Real, usize) {
         .max()
         .unwrap_or(30);
     (tolerance, max_iterations)
-}
-
-fn norm(v: &[Real]) -> Real {
-    v.iter().map(|x| x * x).sum::<Real>().sqrt()
 }

@@ -1,5 +1,6 @@
 use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
 use crate::linkage::assembly::ModelTooLarge;
+use crate::linkage::body_state::{linear_internal_forces, undeformed_axis};
 use crate::linkage::iterative_solver::IterativeSolver;
 use crate::linkage::mechanism::{diagnose_mechanism, Mechanism};
 use crate::linkage::step_state::post_process;
@@ -308,7 +309,7 @@ impl Equilibrium {
         let mut internal = vec![0.0; nd];
         for p in &mut patterns {
             // F_f − K_fs U_s: the internal force of the prescribed displacements alone.
-            self.internal_forces(body, &p.displacements, &mut internal);
+            linear_internal_forces(body, &self.stiffness, &p.displacements, &mut internal);
             for (i, &dof) in self.dofs.free.iter().enumerate() {
                 rhs[i] = p.forces[dof] - internal[dof];
             }
@@ -320,22 +321,6 @@ impl Equilibrium {
             }
         }
         Some(patterns)
-    }
-
-    /// `K u` for a displacement per body DOF, summed member by member, N.
-    fn internal_forces(&self, body: &Body, u: &[Real], out: &mut [Real]) {
-        let d = self.dofs.dofs_per_node;
-        out.iter_mut().for_each(|v| *v = 0.0);
-        for (m, member) in body.members.iter().enumerate() {
-            let [a, b] = member.nodes;
-            let n = axis(body, a, b);
-            let stretch: Real = (0..d).map(|k| n[k] * (u[b * d + k] - u[a * d + k])).sum();
-            let force = self.stiffness[m] * stretch;
-            for k in 0..d {
-                out[a * d + k] -= force * n[k];
-                out[b * d + k] += force * n[k];
-            }
-        }
     }
 
     /// The state at `step` of `steps` (step 0: undeformed, unloaded).
@@ -360,10 +345,10 @@ impl Equilibrium {
             }
         }
         let mut internal = vec![0.0; nd];
-        self.internal_forces(body, &u, &mut internal);
+        linear_internal_forces(body, &self.stiffness, &u, &mut internal);
         let members = body.members.iter().enumerate().map(|(m, member)| {
             let [a, b] = member.nodes;
-            let n = axis(body, a, b);
+            let n = undeformed_axis(body, a, b);
             let stretch: Real = (0..d).map(|k| n[k] * (u[b * d + k] - u[a * d + k])).sum();
             let strain = stretch / body.member_length(m);
             let material = &body.materials[member.material];
@@ -388,11 +373,6 @@ impl Equilibrium {
 fn format_history(history: &[Real]) -> String {
     let items: Vec<String> = history.iter().map(|r| format!("{r:.1e}")).collect();
     items.join(", ")
-}
-
-/// Unit vector from node `a` to node `b` in the undeformed body.
-fn axis(body: &Body, a: usize, b: usize) -> Vector3<Real> {
-    (body.nodes[b] - body.nodes[a]).normalize()
 }
 
 /// Memory the system can still give this process (MemAvailable), bytes; `None` where unknown.

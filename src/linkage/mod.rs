@@ -8,6 +8,7 @@ pub use self::body::{
     MemberProblem, NodalLoad, Schedule, Support,
 };
 pub use self::body_solver::BodySolver;
+pub use self::convergence::{Convergence, NotFinite};
 pub use self::dof_map::{direction_name, DofMap, DofSlot};
 pub use self::equilibrium::{Equilibrium, PhaseTimes, SolveError};
 pub use self::geometry::Geometry;
@@ -26,6 +27,8 @@ pub use self::step_state::StepState;
 mod assembly;
 mod body;
 mod body_solver;
+pub mod body_state;
+mod convergence;
 mod dof_map;
 mod equilibrium;
 pub mod generators;

@@ -7,16 +7,18 @@
 //! Under load control each increment starts from the path extrapolated through the last
 //! converged states when that is closer to equilibrium, which saves the predictor's solve.
 
+use crate::linkage::body_state::{
+    fill_tangent, full_loads, internal_forces, member_response_at, norm, prescribed_at,
+    tangent_times,
+};
 use crate::linkage::line_search::backtrack;
 use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::step_state::{force_scale, post_process};
 use crate::linkage::tangent_solver::{TangentError, TangentSolver};
 use crate::linkage::{
-    direction_name, member_response, prescribed_displacements, Body, DofMap, MemberResponse,
-    PathMethod, PhaseTimes, Schedule, SolveError, StepState, StiffnessAssembly,
+    direction_name, Body, DofMap, PathMethod, PhaseTimes, SolveError, StepState, StiffnessAssembly,
 };
 use crate::Real;
-use nalgebra::Vector3;
 use std::time::Instant;
 
 /// Why one load increment failed (the step is retried with half the increment).
@@ -238,10 +240,9 @@ impl NewtonEquilibrium {
     fn state(&self, body: &Body, steps: usize) -> StepState {
         let forces = self.forces_at(body, self.step as Real, steps);
         let mut internal = vec![0.0; self.u.len()];
-        internal_forces(body, self.dofs.dofs_per_node, &self.u, &mut internal);
-        let d = self.dofs.dofs_per_node;
+        internal_forces(body, &self.u, &mut internal);
         let members = (0..body.members.len()).map(|m| {
-            let r = response(body, d, &self.u, m);
+            let r = member_response_at(body, &self.u, m);
             (r.strain, r.force)
         });
         let mut state = post_process(body, &self.dofs, &self.u, &forces, &internal, members);
@@ -273,39 +274,21 @@ impl NewtonEquilibrium {
                 .map(|f| f * self.lambda)
                 .collect();
         }
-        let d = self.dofs.dofs_per_node;
-        let mut f = vec![0.0; body.dof_count()];
-        for l in &body.loads {
-            let factor = factor_at(&l.schedule, t, steps);
-            for k in 0..d {
-                f[l.node * d + k] += factor * l.force[k];
-            }
-        }
-        f
+        crate::linkage::body_state::loads_at(body, t, steps)
     }
 
     /// The loads at full value per body DOF, N: the arc-length reference pattern.
     fn reference(&self, body: &Body) -> Vec<Real> {
-        let d = self.dofs.dofs_per_node;
-        let mut f = vec![0.0; body.dof_count()];
-        for l in &body.loads {
-            for k in 0..d {
-                f[l.node * d + k] += l.force[k];
-            }
-        }
-        f
+        full_loads(body)
     }
 
     /// Prescribed displacement per body DOF at pseudo-time `t`, m (zero at free DOFs).
     fn prescribed_at(&self, body: &Body, t: Real, steps: usize) -> Vec<Real> {
-        prescribed_displacements(body, |schedule| factor_at(schedule, t, steps))
+        prescribed_at(body, t, steps)
     }
 
     fn fill_tangent(&mut self, body: &Body) {
-        let d = self.dofs.dofs_per_node;
-        let u = &self.u;
-        self.assembly
-            .fill(body, |m| response(body, d, u, m).tangent, &mut self.values);
+        fill_tangent(body, &self.assembly, &self.u, &mut self.values);
     }
 
     fn factorize(&mut self) -> Result<usize, TangentError> {
@@ -357,7 +340,7 @@ impl NewtonEquilibrium {
     /// (timed as assembly).
     fn out_of_balance(&mut self, body: &Body, forces: &[Real], internal: &mut [Real]) -> Vec<Real> {
         let t = Instant::now();
-        internal_forces(body, self.dofs.dofs_per_node, &self.u, internal);
+        internal_forces(body, &self.u, internal);
         self.times.assembly += t.elapsed().as_secs_f64();
         self.dofs
             .free
@@ -513,7 +496,7 @@ impl NewtonEquilibrium {
         }
         if moved {
             let mut k_du = vec![0.0; nd];
-            tangent_times(body, self.dofs.dofs_per_node, &self.u, &du_s, &mut k_du);
+            tangent_times(body, &self.u, &du_s, &mut k_du);
             for (i, &dof) in self.dofs.free.iter().enumerate() {
                 rhs[i] -= k_du[dof];
             }
@@ -823,77 +806,6 @@ fn not_converged(
         reason: failure.reason,
         history: failure.history,
     }
-}
-
-/// A schedule's factor at pseudo-time `t` (step units): linear between the factors of the
-/// steps around it, exact at whole steps.
-fn factor_at(schedule: &Schedule, t: Real, steps: usize) -> Real {
-    let k = t.ceil().max(1.0) as usize;
-    let f1 = schedule.factor(k, steps);
-    let f0 = schedule.factor(k - 1, steps);
-    let w = t - (k - 1) as Real;
-    if w >= 1.0 {
-        f1
-    } else {
-        f0 + w * (f1 - f0)
-    }
-}
-
-fn node_vector(u: &[Real], d: usize, node: usize) -> Vector3<Real> {
-    let mut v = Vector3::zeros();
-    for k in 0..d {
-        v[k] = u[node * d + k];
-    }
-    v
-}
-
-/// The response of member `m` at the displacement `u` (per body DOF).
-fn response(body: &Body, d: usize, u: &[Real], m: usize) -> MemberResponse {
-    let member = body.members[m];
-    let [a, b] = member.nodes;
-    member_response(
-        body.kinematics,
-        &body.materials[member.material],
-        &body.nodes[a],
-        &body.nodes[b],
-        &node_vector(u, d, a),
-        &node_vector(u, d, b),
-    )
-}
-
-/// The internal (member) force per body DOF at `u`, N: member `m` pushes its ends with
-/// `∓N n`.
-fn internal_forces(body: &Body, d: usize, u: &[Real], out: &mut [Real]) {
-    out.iter_mut().for_each(|v| *v = 0.0);
-    for m in 0..body.members.len() {
-        let r = response(body, d, u, m);
-        let [a, b] = body.members[m].nodes;
-        for k in 0..d {
-            out[a * d + k] -= r.force * r.axis[k];
-            out[b * d + k] += r.force * r.axis[k];
-        }
-    }
-}
-
-/// `K_T(u) v` over all body DOFs, member by member, N.
-fn tangent_times(body: &Body, d: usize, u: &[Real], v: &[Real], out: &mut [Real]) {
-    out.iter_mut().for_each(|x| *x = 0.0);
-    for m in 0..body.members.len() {
-        let [a, b] = body.members[m].nodes;
-        let dv = node_vector(v, d, b) - node_vector(v, d, a);
-        if dv == Vector3::zeros() {
-            continue;
-        }
-        let f = response(body, d, u, m).tangent * dv;
-        for k in 0..d {
-            out[a * d + k] -= f[k];
-            out[b * d + k] += f[k];
-        }
-    }
-}
-
-fn norm(v: &[Real]) -> Real {
-    v.iter().map(|x| x * x).sum::<Real>().sqrt()
 }
 
 fn dot_product(a: &[Real], b: &[Real]) -> Real {
