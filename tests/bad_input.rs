@@ -51,11 +51,53 @@ fn assert_has(msg: &str, parts: &[&str]) {
     }
 }
 
+/// The case every other test spoils, as given, solves: the paper's square (Fig. 5), node 3
+/// pinned, node 4 held in y, 200 N along x at node 2. The supports answer with the reactions
+/// statics gives (moments about node 3: node 4 carries 200 N up, node 3 200 N down and 200 N
+/// back), node 2 moves along the load, node 3 stays put.
 #[test]
 fn the_good_case_solves() {
     let c = Case::new();
-    let world = load_scene(&c.scene(SUPPORTS)).unwrap();
-    Simulation::new(&world).unwrap();
+    let world = load_scene(&c.scene(&format!(
+        "{SUPPORTS}[[bodies.loads]]\nnodes = [2]\nforce = [200.0, 0.0]\n"
+    )))
+    .unwrap();
+    assert_eq!(world.steps, 1);
+    let sim = Simulation::new(&world).unwrap_or_else(|e| panic!("{e}"));
+    let (step, summary) = sim.step(1).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((step.step, step.load_factor), (1, 1.0));
+    assert!(summary.residual <= 1e-9, "residual {}", summary.residual);
+    assert_eq!(step.bodies.len(), 1);
+    let body = &step.bodies[0];
+    assert_eq!(body.name, "sq");
+    assert_eq!(body.displacements.len(), 4);
+    assert_eq!(body.axial_forces.len(), 6);
+    assert!(body.axial_forces.iter().all(|f| f.is_finite()));
+    assert_eq!(body.displacements[2], [0.0, 0.0], "node 3 is pinned");
+    assert_eq!(body.displacements[3][1], 0.0, "node 4 is held in y");
+    assert!(body.displacements[1][0] > 0.0, "{:?}", body.displacements);
+    assert!(summary.max_displacement > 0.0);
+    let reaction = |node: usize| {
+        body.reactions
+            .iter()
+            .find(|r| r.node == node)
+            .unwrap_or_else(|| panic!("a reaction at node {node}: {:?}", body.reactions))
+            .force
+            .clone()
+    };
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * 200.0;
+    let r3 = reaction(3);
+    let r4 = reaction(4);
+    assert!(
+        close(r3[0], -200.0) && close(r3[1], -200.0),
+        "node 3: {r3:?}"
+    );
+    assert!(close(r4[0], 0.0) && close(r4[1], 200.0), "node 4: {r4:?}");
+    assert_eq!(body.loads.len(), 1);
+    assert_eq!(
+        (body.loads[0].node, &body.loads[0].force),
+        (2, &vec![200.0, 0.0])
+    );
 }
 
 #[test]

@@ -105,7 +105,11 @@ fn a_failing_scene_fails_the_batch_but_not_the_others_and_leaves_nothing() {
         stdout.contains("FAIL") && stdout.contains("bad.toml") && stdout.contains("rigid-body"),
         "{stdout}"
     );
-    assert!(out.join("paper_square/summary.json").exists());
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("paper_square/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["scene"], "paper_square");
+    assert_eq!(summary["steps"].as_array().unwrap().len(), 2);
     assert!(!out.join("bad").exists(), "a failed scene leaves no output");
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1);
 }
@@ -153,20 +157,85 @@ fn output_every_and_last_only() {
     assert_eq!(summary["steps"].as_array().unwrap().len(), 11);
 }
 
+/// `linkage check` reads the scenes and prints their sizes, and solves nothing: a scene whose
+/// fourth step cannot be solved (a load past the truss's limit point, which `linkage run`
+/// reports as a failure) passes the check, the working folder stays empty (no results folder,
+/// no `batch.csv`), and no timings or residuals are printed.
 #[test]
 fn check_prints_sizes_without_solving() {
+    let here = std::env::current_dir().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let unsolvable = dir.path().join("overload.toml");
+    std::fs::write(
+        &unsolvable,
+        format!(
+            "name = \"overload\"\nsteps = 4\n[[materials]]\nname = \"steel\"\nyoungs_modulus = 200e9\narea = 1e-4\n[[bodies]]\nname = \"truss\"\nnodes = \"{}\"\nlinks = \"{}\"\nkinematics = \"large\"\n[bodies.newton]\nmax_cuts = 3\n[[bodies.supports]]\nnodes = [1, 3]\nfix = [\"x\", \"y\"]\n[[bodies.loads]]\nnodes = [2]\nforce = [0.0, -9000.0]\n",
+            here.join("scenes/von_mises.nodes").display(),
+            here.join("scenes/von_mises.links").display()
+        ),
+    )
+    .unwrap();
+    // Run from an empty folder, so anything check writes shows.
+    let cwd = dir.path().join("cwd");
+    std::fs::create_dir(&cwd).unwrap();
     let result = linkage()
-        .args([
-            "check",
-            "scenes/paper_shell.toml",
-            "scenes/paper_square.toml",
-        ])
+        .current_dir(&cwd)
+        .arg("check")
+        .arg(here.join("scenes/paper_shell.toml"))
+        .arg(here.join("scenes/paper_square.toml"))
+        .arg(&unsolvable)
         .output()
         .unwrap();
-    assert!(result.status.success());
     let stdout = String::from_utf8_lossy(&result.stdout);
+    assert!(
+        result.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    assert_eq!(
+        stdout.lines().filter(|l| l.starts_with("ok")).count(),
+        3,
+        "{stdout}"
+    );
     assert!(stdout.contains("4 nodes, 6 members"), "{stdout}");
-    assert!(Path::new("scenes/paper_shell.toml").exists());
+    let shell = linkage::scene::load_scene(Path::new("scenes/paper_shell.toml")).unwrap();
+    let (nodes, members) = (shell.bodies[0].nodes.len(), shell.bodies[0].members.len());
+    assert!(
+        stdout.contains(&format!("{nodes} nodes, {members} members")),
+        "paper_shell's {nodes} nodes and {members} members: {stdout}"
+    );
+    assert!(stdout.contains("overload.toml"), "{stdout}");
+    for solved in [" s;", "residual", "phases", "max |u|", "did not converge"] {
+        assert!(
+            !stdout.contains(solved),
+            "check solved ({solved:?}): {stdout}"
+        );
+    }
+    assert_eq!(
+        std::fs::read_dir(&cwd).unwrap().count(),
+        0,
+        "check wrote into the working folder"
+    );
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        2,
+        "check wrote beside the scene"
+    );
+    // The same scene does not solve: the check above passed without trying.
+    let run = linkage()
+        .current_dir(&cwd)
+        .arg("run")
+        .arg(&unsolvable)
+        .arg("--out")
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    assert!(!run.status.success());
+    assert!(
+        String::from_utf8_lossy(&run.stdout).contains("step 4 did not converge"),
+        "{}",
+        String::from_utf8_lossy(&run.stdout)
+    );
     let missing = linkage()
         .args(["check", "scenes/nope.toml"])
         .output()

@@ -28,6 +28,35 @@ fn run_png_vtk_then_render_again_with_other_options() {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
 
+    // Render reads the stored run and solves nothing: the results (and the frames and GIF it
+    // is not asked for) keep their bytes and modification times, and no timing of a solve is
+    // printed; only the asked-for frame is drawn anew.
+    let results = [
+        "summary.json",
+        "model.json",
+        "steps/0000.json",
+        "steps/0001.json",
+        "png/0000.png",
+        "anim.gif",
+        "vtk/0001.vtu",
+        "vtk/paper_square.pvd",
+    ];
+    let stamp = |f: &str| {
+        let path = dir.join(f);
+        let modified = std::fs::metadata(&path).unwrap().modified().unwrap();
+        (std::fs::read(&path).unwrap(), modified)
+    };
+    let before: Vec<_> = results.iter().map(|f| stamp(f)).collect();
+    let frame_before = stamp("png/0001.png");
+    let listing = |d: &std::path::Path| {
+        let mut names: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        names
+    };
+    let steps_before = listing(&dir.join("steps"));
     let o = linkage()
         .arg("render")
         .arg(&dir)
@@ -40,7 +69,25 @@ fn run_png_vtk_then_render_again_with_other_options() {
     let png =
         tiny_skia::Pixmap::decode_png(&std::fs::read(dir.join("png/0001.png")).unwrap()).unwrap();
     assert_eq!((png.width(), png.height()), (300, 200));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("drew 1 step"));
+    let frame_after = stamp("png/0001.png");
+    assert_ne!(
+        frame_after.0, frame_before.0,
+        "the last frame was drawn again"
+    );
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("drew 1 step"), "{stdout}");
+    for solved in ["phases", "residual", "max |u|", "factorization"] {
+        assert!(
+            !stdout.contains(solved),
+            "render solved ({solved:?}): {stdout}"
+        );
+    }
+    for (f, was) in results.iter().zip(&before) {
+        let now = stamp(f);
+        assert!(now.0 == was.0, "render changed the bytes of {f}");
+        assert_eq!(now.1, was.1, "render rewrote {f}");
+    }
+    assert_eq!(listing(&dir.join("steps")), steps_before);
 
     let o = linkage()
         .arg("render")
@@ -85,7 +132,9 @@ fn bundled_scenes_produce_their_frames_and_gifs() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    let mut folders = 0;
     for entry in std::fs::read_dir(out.path()).unwrap() {
+        folders += 1;
         let dir = entry.unwrap().path();
         let steps = std::fs::read_dir(dir.join("steps")).unwrap().count();
         let frames = std::fs::read_dir(dir.join("png")).unwrap().count();
@@ -98,5 +147,17 @@ fn bundled_scenes_produce_their_frames_and_gifs() {
             n += 1;
         }
         assert_eq!(n, steps, "{}", dir.display());
+        assert!(
+            steps >= 2,
+            "{}: step 0 and at least one solved",
+            dir.display()
+        );
     }
+    // One results folder per scene: the loop above saw them all.
+    assert_eq!(
+        folders,
+        scenes.len(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
 }

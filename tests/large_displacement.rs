@@ -2,9 +2,10 @@
 //! is against a closed form or an exact property, with its tolerance stated where it is used.
 
 use linkage::linkage::{
-    Behaviour, Body, BodySolver, Dimension, Kinematics, Material, Member, NewtonEquilibrium,
-    NodalLoad, PathMethod, Schedule, StepState, Support,
+    Behaviour, Body, BodyError, BodySolver, Dimension, Kinematics, Material, Member,
+    NewtonEquilibrium, NodalLoad, PathMethod, Schedule, SolveError, StepState, Support,
 };
+use linkage::scene::RunError;
 use nalgebra::Vector3;
 
 fn v(x: f64, y: f64) -> Vector3<f64> {
@@ -313,11 +314,55 @@ fn slack_cable_carries_no_force() {
     }
 }
 
+/// A bad arc length (negative, zero, not finite) is refused before any solve, as a
+/// [`BodyError::BadValue`] naming the body, the setting and what to give instead; so are
+/// prescribed support displacements, which the arc-length method cannot scale.
 #[test]
 fn arc_length_path_setting_is_checked() {
+    for length in [-1.0, 0.0, f64::NAN, f64::INFINITY] {
+        let mut body = von_mises(1.0);
+        body.newton.path = PathMethod::ArcLength { length };
+        let err = BodySolver::new(&body)
+            .err()
+            .unwrap_or_else(|| panic!("arc_length = {length} was accepted"));
+        let message = err.to_string();
+        match err {
+            SolveError::Body(BodyError::BadValue {
+                body,
+                what,
+                problem,
+            }) => {
+                assert_eq!(body, "von_mises");
+                assert_eq!(what, "[bodies.path]");
+                assert!(
+                    problem.contains(&format!("arc_length = {length}"))
+                        && problem.contains("finite positive length in m"),
+                    "{problem}"
+                );
+            }
+            other => panic!("arc_length = {length}: expected a bad value, got {other:?}"),
+        }
+        assert!(
+            message.starts_with("body 'von_mises': [bodies.path]: arc_length = "),
+            "{message}"
+        );
+    }
     let mut body = von_mises(1.0);
-    body.newton.path = PathMethod::ArcLength { length: -1.0 };
-    assert!(BodySolver::new(&body).is_err());
+    body.newton.path = PathMethod::ArcLength { length: 0.004 };
+    body.supports[0] = moved(0, [true, true, false], v(0.0, -0.01));
+    let err = BodySolver::new(&body)
+        .err()
+        .expect("prescribed displacements with an arc-length path are refused");
+    let message = err.to_string();
+    assert!(
+        matches!(&err, SolveError::Body(BodyError::BadValue { body, .. }) if body == "von_mises"),
+        "{err:?}"
+    );
+    assert!(
+        message.contains("prescribed support displacements are not allowed")
+            && message.contains("method = \"schedules\""),
+        "{message}"
+    );
 }
 
 /// The arc-length method traces the whole path of the shallow two-bar truss: up to the limit
@@ -452,8 +497,53 @@ force = [0.0, -9000.0]   # 1.18 times the limit load (7622 N)
         assert_eq!(s["cuts"], 0);
         assert!(s["iterations"].as_u64().unwrap() >= 2);
     }
-    assert!(out.join("overload/steps/0003.json").exists());
+    let step3: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("overload/steps/0003.json")).unwrap())
+            .unwrap();
+    assert_eq!(step3["step"], 3);
+    assert_eq!(step3["bodies"][0]["name"], "truss");
+    // The apex (node 2) went down under the downward load.
+    assert!(
+        step3["bodies"][0]["displacements"][1][1].as_f64().unwrap() < 0.0,
+        "{}",
+        step3["bodies"][0]["displacements"]
+    );
     assert!(!out.join("overload/steps/0004.json").exists());
+
+    // The library says the same as a typed error: the body, the step, the halvings, the
+    // residuals of the last attempt.
+    let world = linkage::scene::load_scene(&scene).unwrap();
+    let again = dir.path().join("again");
+    let err = linkage::scene::run(&world, &again, &|| {}).expect_err("step 4 cannot be solved");
+    let message = err.to_string();
+    match err {
+        RunError::Solve {
+            scene: file,
+            source:
+                SolveError::NotConverged {
+                    body,
+                    step,
+                    depth,
+                    history,
+                    ..
+                },
+        } => {
+            assert_eq!(file, scene);
+            assert_eq!(body, "truss");
+            assert_eq!(step, 4);
+            assert_eq!(depth, 3);
+            assert!(!history.is_empty(), "the last attempt's residuals");
+        }
+        other => panic!("expected a step that did not converge, got {other:?}"),
+    }
+    assert!(
+        message.contains("overload.toml")
+            && message.contains("Use more steps")
+            && message.contains("method = \"arc_length\""),
+        "{message}"
+    );
+    assert!(again.join("overload/steps/0003.json").is_file());
+    assert!(!again.join("overload/steps/0004.json").exists());
 }
 
 /// A strut (compression-only) pulled carries nothing; pushed, it carries the load.

@@ -326,6 +326,7 @@ fn run_with_png_writes_a_frame_per_step_and_a_gif_and_times_drawing() {
         .unwrap()
         .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
+    assert!(names.iter().any(|n| n == "0003.png"), "{names:?}");
     assert!(names.iter().all(|n| !n.starts_with('.')), "{names:?}");
 }
 
