@@ -18,7 +18,7 @@ use std::borrow::Cow;
 /// Factor the level directly once it has at most this many unknowns.
 const COARSE_SIZE: usize = 3000;
 
-/// The multigrid hierarchy: apply it with [`SmoothedAggregation::apply`].
+/// The multigrid hierarchy: apply it with [`Preconditioner::apply`](crate::linalg::Preconditioner::apply).
 pub struct SmoothedAggregation {
     pub(super) levels: Vec<Level>,
     pub(super) work: Vec<Work>,
