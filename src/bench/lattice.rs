@@ -151,16 +151,10 @@ pub fn measure_iterative(cells: [usize; 3], multigrid: bool) -> Result<Iterative
     let assembly = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let mut m: Box<dyn Preconditioner> = if multigrid {
-        let directions: Vec<usize> = dofs.free.iter().map(|d| d % dofs.dofs_per_node).collect();
+        let near_null_space = crate::linkage::rigid_modes::rigid_body_rows(&body.nodes, &dofs);
         Box::new(
-            SmoothedAggregation::new(
-                &csr,
-                &asm.groups,
-                &directions,
-                &body.nodes,
-                dofs.dofs_per_node,
-            )
-            .map_err(|e| e.to_string())?,
+            SmoothedAggregation::new(&csr, &asm.groups, &near_null_space)
+                .map_err(|e| e.to_string())?,
         )
     } else {
         Box::new(BlockJacobi::new(&csr, &asm.groups).map_err(|e| e.to_string())?)

@@ -2,10 +2,12 @@
 //! the pattern in full rows is built once, the values refilled, the hierarchy rebuilt only when
 //! the matrix has drifted far enough that the iterations grow, every solve warm-started.
 
+use crate::linalg::multigrid::MODES;
 use crate::linalg::{
     conjugate_gradient, dot, CgReport, CgSettings, MultigridError, SmoothedAggregation,
     SymmetricCsr,
 };
+use crate::linkage::rigid_modes::rigid_body_rows;
 use crate::linkage::{DofMap, IterativeSettings, StiffnessAssembly};
 use crate::Real;
 use nalgebra::Vector3;
@@ -18,9 +20,8 @@ pub(crate) struct IterativeSolver {
     matrix: SymmetricCsr,
     multigrid: Option<SmoothedAggregation>,
     groups: Vec<usize>,
-    directions: Vec<usize>,
-    nodes: Vec<Vector3<Real>>,
-    dimension: usize,
+    /// The multigrid's near-null space: the rigid-body rows of every free DOF.
+    near_null_space: Vec<[Real; MODES]>,
     settings: IterativeSettings,
     /// Iterations of the first solve with the current hierarchy: the yardstick for rebuilding.
     fresh_iterations: Option<usize>,
@@ -45,9 +46,7 @@ impl IterativeSolver {
             matrix: SymmetricCsr::from_lower(assembly.n, &assembly.col_ptr, &assembly.row_idx),
             multigrid: None,
             groups: assembly.groups.clone(),
-            directions: dofs.free.iter().map(|d| d % dofs.dofs_per_node).collect(),
-            nodes: nodes.to_vec(),
-            dimension: dofs.dofs_per_node,
+            near_null_space: rigid_body_rows(nodes, dofs),
             settings,
             fresh_iterations: None,
             stale: false,
@@ -68,9 +67,7 @@ impl IterativeSolver {
         self.multigrid = Some(SmoothedAggregation::new(
             &self.matrix,
             &self.groups,
-            &self.directions,
-            &self.nodes,
-            self.dimension,
+            &self.near_null_space,
         )?);
         self.fresh_iterations = None;
         self.stale = false;

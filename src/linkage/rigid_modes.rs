@@ -1,4 +1,5 @@
-//! The rigid motions a body's supports leave free, and the DOFs that pin them.
+//! The rigid motions a body's supports leave free, the DOFs that pin them, and the rigid-body
+//! rows of the multigrid's near-null space.
 //!
 //! A body held only by contact (no supports, or supports that leave it free to slide) has a
 //! singular stiffness matrix whose null space is those rigid motions. Fixing one DOF per free
@@ -6,6 +7,7 @@
 //! pinning), gives a regular matrix whose inverse is a generalized inverse of the singular one:
 //! for a self-equilibrated load it returns one of its solutions.
 
+use crate::linalg::multigrid::MODES;
 use crate::linkage::{Body, Dimension, DofMap};
 use crate::Real;
 use nalgebra::{DMatrix, SymmetricEigen, Vector3};
@@ -75,6 +77,34 @@ pub fn free_rigid_modes(body: &Body, dofs: &DofMap) -> Vec<Vec<Real>> {
         }
     }
     modes
+}
+
+/// The rigid-body motions about the centroid of `nodes` (positions, m) as the multigrid's
+/// near-null space: one row per free DOF of `dofs` (in the order of `dofs.free`), the
+/// translation along the DOF's direction first, then the rotations (about z in 2D, in row
+/// 2; about x, y, z in 3D, in rows 3 to 5: the axis × the position about the centroid, m);
+/// the other values zero. Not normalised: the multigrid orthonormalises per aggregate.
+pub fn rigid_body_rows(nodes: &[Vector3<Real>], dofs: &DofMap) -> Vec<[Real; MODES]> {
+    let centre = nodes.iter().sum::<Vector3<Real>>() / nodes.len().max(1) as Real;
+    let mut rows = vec![[0.0; MODES]; dofs.free.len()];
+    for (row, &dof) in rows.iter_mut().zip(&dofs.free) {
+        let (node, d) = dofs.node_and_direction(dof);
+        let p = nodes[node] - centre;
+        row[d] = 1.0;
+        if dofs.dofs_per_node == 2 {
+            // Rotation about z: (−y, x).
+            row[2] = if d == 0 { -p.y } else { p.x };
+        } else {
+            // Rotations about x, y, z: a × p.
+            let rx = Vector3::new(0.0, -p.z, p.y);
+            let ry = Vector3::new(p.z, 0.0, -p.x);
+            let rz = Vector3::new(-p.y, p.x, 0.0);
+            row[3] = rx[d];
+            row[4] = ry[d];
+            row[5] = rz[d];
+        }
+    }
+    rows
 }
 
 /// One free DOF per mode such that the modes restricted to them are independent (greedy:

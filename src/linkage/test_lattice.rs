@@ -1,21 +1,22 @@
 //! A lattice stiffness system for the solver tests (one fixture instead of one per test module),
 //! and the tests of `crate::linalg` that run on it: `linalg` knows no bodies, so they live here.
 
+use crate::linalg::multigrid::MODES;
 use crate::linalg::SymmetricCsr;
 use crate::linkage::generators::lattice_body;
-use crate::linkage::{axial_stiffness, member_block, Body, DofMap, StiffnessAssembly};
+use crate::linkage::rigid_modes::rigid_body_rows;
+use crate::linkage::{axial_stiffness, member_block, DofMap, StiffnessAssembly};
 use crate::Real;
 
 /// `K_ff` of a lattice of `cells` with its bottom face fixed (see [`lattice_body`]).
 pub(crate) struct LatticeSystem {
-    pub body: Body,
     pub assembly: StiffnessAssembly,
     /// Lower-triangle values in the assembly's pattern.
     pub values: Vec<Real>,
     /// The same matrix in full rows.
     pub matrix: SymmetricCsr,
-    /// Direction (0, 1, 2) of every free DOF.
-    pub directions: Vec<usize>,
+    /// The rigid-body rows of every free DOF (the multigrid's near-null space).
+    pub near_null_space: Vec<[Real; MODES]>,
 }
 
 pub(crate) fn lattice_system(cells: [usize; 3]) -> LatticeSystem {
@@ -34,13 +35,12 @@ pub(crate) fn lattice_system(cells: [usize; 3]) -> LatticeSystem {
     );
     let mut matrix = SymmetricCsr::from_lower(assembly.n, &assembly.col_ptr, &assembly.row_idx);
     matrix.refill(&values);
-    let directions = dofs.free.iter().map(|d| d % dofs.dofs_per_node).collect();
+    let near_null_space = rigid_body_rows(&body.nodes, &dofs);
     LatticeSystem {
-        body,
         assembly,
         values,
         matrix,
-        directions,
+        near_null_space,
     }
 }
 
@@ -156,8 +156,7 @@ mod tests {
             matrix: csr,
             assembly: asm,
             values,
-            directions,
-            body,
+            near_null_space,
         } = lattice_system([8, 8, 10]);
         let b: Vec<Real> = (0..asm.n)
             .map(|i| ((i * 7919) % 13) as Real - 6.0)
@@ -169,15 +168,9 @@ mod tests {
         chol.solve_in_place(&mut direct);
 
         // Three levels at least: a small coarse size forces recursion.
-        let mut amg = SmoothedAggregation::with_coarse_size(
-            &csr,
-            &asm.groups,
-            &directions,
-            &body.nodes,
-            3,
-            200,
-        )
-        .unwrap();
+        let mut amg =
+            SmoothedAggregation::with_coarse_size(&csr, &asm.groups, &near_null_space, 200)
+                .unwrap();
         assert!(amg.sizes.len() >= 3, "{:?}", amg.sizes);
         let mut x = vec![0.0; asm.n];
         let report = conjugate_gradient(&csr, &mut amg, &b, &mut x, CgSettings::default());
@@ -196,15 +189,9 @@ mod tests {
             .build()
             .unwrap();
         let (single, one) = pool.install(|| {
-            let mut amg = SmoothedAggregation::with_coarse_size(
-                &csr,
-                &asm.groups,
-                &directions,
-                &body.nodes,
-                3,
-                200,
-            )
-            .unwrap();
+            let mut amg =
+                SmoothedAggregation::with_coarse_size(&csr, &asm.groups, &near_null_space, 200)
+                    .unwrap();
             let mut one = vec![0.0; asm.n];
             let r = conjugate_gradient(&csr, &mut amg, &b, &mut one, CgSettings::default());
             (r, one)
