@@ -487,7 +487,7 @@ fn bench(cells: Vec<[usize; 3]>, iterative: bool, jacobi: bool, in_process: bool
 
 fn render(a: &RenderArgs) -> Result<()> {
     use linkage::render::{render_run, RenderOptions};
-    use linkage::scene::{write_vtk, StoredRun};
+    use linkage::scene::{write_vtk, RunResults};
     // A published results folder always has its summary: without it the folder is not one.
     let summary = a.dir.join("summary.json");
     if !summary.is_file() {
@@ -533,8 +533,8 @@ fn render(a: &RenderArgs) -> Result<()> {
         );
     }
     if a.vtk {
-        let run = StoredRun::open(&a.dir)?;
-        let files = write_vtk(&run)?;
+        let run = RunResults::read(&a.dir)?;
+        let files = write_vtk(&run, &a.dir)?;
         println!(
             "wrote {} ParaView files in {}",
             files.len(),
