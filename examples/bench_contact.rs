@@ -88,17 +88,12 @@ total_force = [0.0, -500.0, 0.0]
     );
     let world = build_world(&scene, Path::new("bench_pair.toml")).expect("a valid scene");
     let t = Instant::now();
-    let sim = Simulation::new(&world).expect("builds");
+    let mut sim = Simulation::new(&world).expect("builds");
     let setup = t.elapsed().as_secs_f64();
     // Phase times of the contact solver so far: assembly (and residuals), ordering and
     // symbolic analysis, factorization (with the compliance), solves, contact queries.
     let phases = |sim: &Simulation| -> [f64; 5] {
-        let c = sim
-            .contact
-            .as_ref()
-            .expect("a contact scene")
-            .lock()
-            .expect("not poisoned");
+        let c = sim.contact().expect("a contact scene");
         [
             c.times.assembly,
             c.times.symbolic,
@@ -107,17 +102,13 @@ total_force = [0.0, -500.0, 0.0]
             c.query_seconds,
         ]
     };
-    let condensed = sim
-        .contact
-        .as_ref()
-        .is_some_and(|c| c.lock().is_ok_and(|c| c.is_condensed()));
+    let condensed = sim.contact().is_some_and(|c| c.is_condensed());
     let p0 = phases(&sim);
     println!(
         "pair   2 × {} nodes ({} free DOFs), {} load steps of 500/{} N, {}: set-up {:.2} s (ordering+symbolic {:.2} s, factorization and compliance {:.2} s, load-pattern solves {:.2} s)",
         world.bodies[0].nodes.len(),
-        sim.contact
-            .as_ref()
-            .and_then(|c| c.lock().ok().map(|c| c.free_dofs(0) + c.free_dofs(1)))
+        sim.contact()
+            .map(|c| c.free_dofs(0) + c.free_dofs(1))
             .unwrap_or(0),
         STEPS,
         STEPS,

@@ -215,20 +215,6 @@ fn main() -> ExitCode {
     }
 }
 
-fn describe(world: &World) -> String {
-    let nodes: usize = world.bodies.iter().map(|b| b.nodes.len()).sum();
-    let members: usize = world.bodies.iter().map(|b| b.members.len()).sum();
-    let patches: usize = world.bodies.iter().map(|b| b.patches.len()).sum();
-    let dofs: usize = world.bodies.iter().map(|b| b.dof_count()).sum();
-    format!(
-        "{} bod{}, {nodes} nodes, {members} members, {patches} patches, {dofs} DOFs, {} step{}",
-        world.bodies.len(),
-        if world.bodies.len() == 1 { "y" } else { "ies" },
-        world.steps,
-        if world.steps == 1 { "" } else { "s" }
-    )
-}
-
 fn run_scenes(
     scenes: &[PathBuf],
     out: &Path,
@@ -287,7 +273,7 @@ fn run_scenes(
                     "ok    {} -> {}: {}; {:.3} s; max |u| {:.4e} m; {} overloaded; residual {:.1e}",
                     path.display(),
                     out.join(&world.name).display(),
-                    describe(&world),
+                    world.describe(),
                     seconds,
                     last.map_or(0.0, |s| s.max_displacement),
                     last.map_or(0, |s| s.overloaded),
@@ -332,7 +318,7 @@ fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
     let mut failed = 0;
     for path in scenes {
         match load_scene(path) {
-            Ok(world) => println!("ok    {}: {}", path.display(), describe(&world)),
+            Ok(world) => println!("ok    {}: {}", path.display(), world.describe()),
             Err(e) => {
                 failed += 1;
                 println!("FAIL  {e}");
@@ -487,7 +473,7 @@ fn bench(cells: Vec<[usize; 3]>, iterative: bool, jacobi: bool, in_process: bool
 
 fn render(a: &RenderArgs) -> Result<()> {
     use linkage::render::{render_run, RenderOptions};
-    use linkage::scene::{write_vtk, StoredRun};
+    use linkage::scene::{write_vtk, RunResults};
     // A published results folder always has its summary: without it the folder is not one.
     let summary = a.dir.join("summary.json");
     if !summary.is_file() {
@@ -533,8 +519,8 @@ fn render(a: &RenderArgs) -> Result<()> {
         );
     }
     if a.vtk {
-        let run = StoredRun::open(&a.dir)?;
-        let files = write_vtk(&run)?;
+        let run = RunResults::read(&a.dir)?;
+        let files = write_vtk(&run, &a.dir)?;
         println!(
             "wrote {} ParaView files in {}",
             files.len(),

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 /// Solve every step of `world` in order; the results and summaries.
 fn run_all(world: &linkage::scene::World) -> Vec<(StepResult, StepSummary)> {
-    let sim = Simulation::new(world).expect("builds");
+    let mut sim = Simulation::new(world).expect("builds");
     (0..=world.steps)
         .map(|k| sim.step(k).expect("solves"))
         .collect()
@@ -938,18 +938,16 @@ normal = [0.0, 1.0, 0.0]
 max_iterations = 100
 "#;
     let mut world = build_world(scene, Path::new("falling_box.toml")).unwrap();
-    let sim = Simulation::new(&world).unwrap();
+    let mut sim = Simulation::new(&world).unwrap();
     let before = sim
-        .contact
-        .as_ref()
-        .and_then(|c| c.lock().unwrap().candidate_nodes(0))
+        .contact()
+        .and_then(|c| c.candidate_nodes(0))
         .expect("condensed");
     assert_eq!(before, 0, "nothing is near the floor at first");
     let condensed: Vec<_> = (0..=world.steps).map(|k| sim.step(k).unwrap()).collect();
     let after = sim
-        .contact
-        .as_ref()
-        .and_then(|c| c.lock().unwrap().candidate_nodes(0))
+        .contact()
+        .and_then(|c| c.candidate_nodes(0))
         .expect("still condensed");
     assert!(
         after >= 25,
@@ -1076,7 +1074,7 @@ normal = [0.0, 1.0]
         scene,
     );
     let world = load_scene(&path).unwrap();
-    let sim = Simulation::new(&world).unwrap();
+    let mut sim = Simulation::new(&world).unwrap();
     let error = (0..=world.steps)
         .find_map(|k| sim.step(k).err().map(|e| e.to_string()))
         .expect("the frame cannot be solved");

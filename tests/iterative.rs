@@ -8,7 +8,7 @@ use linkage::scene::{load_scene, Simulation, World};
 
 /// Every displacement of every step, flattened.
 fn displacements(world: &World) -> Vec<f64> {
-    let sim = Simulation::new(world).unwrap();
+    let mut sim = Simulation::new(world).unwrap();
     let mut out = Vec::new();
     for step in 0..=world.steps {
         let (result, _) = sim.step(step).unwrap();
@@ -86,7 +86,7 @@ fn lattices_agree_with_the_direct_solver() {
     for cells in [[3, 3, 4], [6, 5, 8], [10, 10, 14]] {
         let mut body = lattice_body(cells).unwrap();
         let solve = |body: &Body| {
-            let s = BodySolver::new(body).unwrap();
+            let mut s = BodySolver::new(body).unwrap();
             let state = s.solve_step(body, 1, 1).unwrap();
             (
                 state
@@ -124,7 +124,7 @@ fn warm_starts_reduce_iterations_over_a_run() {
         body.kinematics = Kinematics::Large;
         body.solver.choice = SolverChoice::Iterative;
         body.solver.iterative.warm_start = warm;
-        let s = BodySolver::new(&body).unwrap();
+        let mut s = BodySolver::new(&body).unwrap();
         let mut total = 0;
         let mut last = Vec::new();
         for step in 1..=6 {
@@ -189,7 +189,7 @@ fn an_unreachable_tolerance_falls_back_to_the_direct_solver() {
     body.solver.choice = SolverChoice::Iterative;
     body.solver.iterative.tolerance = 1e-300;
     body.solver.iterative.max_iterations = 20;
-    let s = BodySolver::new(&body).unwrap();
+    let mut s = BodySolver::new(&body).unwrap();
     assert_eq!(s.solver_used(), "iterative, then direct");
     let state = s.solve_step(&body, 1, 1).unwrap();
     // The same factorization (faer's parallel kernels may round the last bit differently).

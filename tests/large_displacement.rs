@@ -38,7 +38,7 @@ fn moved(node: usize, fixed: [bool; 3], displacement: Vector3<f64>) -> Support {
 
 /// Solve every step 1..=steps in order; return the states.
 fn solve_all(body: &Body, steps: usize) -> Vec<StepState> {
-    let solver = BodySolver::new(body).expect("solvable");
+    let mut solver = BodySolver::new(body).expect("solvable");
     (1..=steps)
         .map(|s| solver.solve_step(body, s, steps).expect("step converges"))
         .collect()
@@ -584,7 +584,7 @@ fn compression_only_strut_carries_no_tension() {
 fn bundled_von_mises_scene_reports_load_factor_and_stability() {
     let world =
         linkage::scene::load_scene(std::path::Path::new("scenes/von_mises_truss.toml")).unwrap();
-    let sim = linkage::scene::Simulation::new(&world).unwrap();
+    let mut sim = linkage::scene::Simulation::new(&world).unwrap();
     let (w_limit, _) = von_mises_limit();
     let mut unstable = 0;
     for step in 0..=world.steps {

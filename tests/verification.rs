@@ -28,7 +28,7 @@ fn close(a: f64, b: f64, rel: f64) -> bool {
 #[test]
 fn paper_square_matches_hand_calculation() {
     let world = load_scene(Path::new("scenes/paper_square.toml")).unwrap();
-    let sim = Simulation::new(&world).unwrap();
+    let mut sim = Simulation::new(&world).unwrap();
     let (result, summary) = sim.step(1).unwrap();
     let body = &result.bodies[0];
     let (p, pl_ea) = (200.0, 200.0 * 1.0 / 2e7);
@@ -282,7 +282,7 @@ fn load_steps_follow_schedules() {
 #[test]
 fn symmetric_disk_gives_mirror_symmetric_answer() {
     let world = load_scene(Path::new("scenes/paper_disk.toml")).unwrap();
-    let sim = Simulation::new(&world).unwrap();
+    let mut sim = Simulation::new(&world).unwrap();
     let (result, _) = sim.step(world.steps).unwrap();
     let body = &world.bodies[0];
     let u = &result.bodies[0].displacements;
@@ -323,7 +323,7 @@ fn every_bundled_scene_is_in_equilibrium() {
     assert!(scenes.len() >= 5);
     for path in scenes {
         let world = load_scene(&path).unwrap();
-        let sim = Simulation::new(&world).unwrap();
+        let mut sim = Simulation::new(&world).unwrap();
         for step in 0..=world.steps {
             let (result, summary) = sim.step(step).unwrap();
             let mut total = [0.0f64; 3];
@@ -372,7 +372,7 @@ fn every_bundled_scene_is_in_equilibrium() {
 #[test]
 fn overload_grows_with_the_force() {
     let world = load_scene(Path::new("scenes/paper_overload.toml")).unwrap();
-    let sim = Simulation::new(&world).unwrap();
+    let mut sim = Simulation::new(&world).unwrap();
     let mut counts = Vec::new();
     for step in 0..=world.steps {
         let (result, summary) = sim.step(step).unwrap();

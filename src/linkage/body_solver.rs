@@ -1,22 +1,21 @@
 //! The solver a body needs: the paper's linear superposition, or Newton for a nonlinear body.
 
 use crate::linkage::{Body, Equilibrium, NewtonEquilibrium, PhaseTimes, SolveError, StepState};
-use std::sync::Mutex;
 
 /// One body's equilibrium solver, chosen by [`Body::is_nonlinear`].
 pub enum BodySolver {
     /// Linear kinematics and elastic members: factor once, superpose load patterns.
     Linear(Box<Equilibrium>),
-    /// Large kinematics, cables or struts, or an arc-length path: Newton step by step. The
-    /// lock holds the current state so steps can be asked for through a shared reference.
-    Nonlinear(Box<Mutex<NewtonEquilibrium>>),
+    /// Large kinematics, cables or struts, or an arc-length path: Newton step by step, holding
+    /// the current state between steps.
+    Nonlinear(Box<NewtonEquilibrium>),
 }
 
 impl BodySolver {
     /// Validate `body` and prepare its solver (for a linear body: solve it).
     pub fn new(body: &Body) -> Result<Self, SolveError> {
         Ok(if body.is_nonlinear() {
-            BodySolver::Nonlinear(Box::new(Mutex::new(NewtonEquilibrium::new(body)?)))
+            BodySolver::Nonlinear(Box::new(NewtonEquilibrium::new(body)?))
         } else {
             BodySolver::Linear(Box::new(Equilibrium::new(body)?))
         })
@@ -25,17 +24,14 @@ impl BodySolver {
     /// The state at `step` of `steps`. A nonlinear body solves the steps in order (asking
     /// for an earlier step than the last one solved restarts it).
     pub fn solve_step(
-        &self,
+        &mut self,
         body: &Body,
         step: usize,
         steps: usize,
     ) -> Result<StepState, SolveError> {
         match self {
             BodySolver::Linear(eq) => eq.solve_step(body, step, steps),
-            BodySolver::Nonlinear(newton) => newton
-                .lock()
-                .unwrap_or_else(|poisoned| poisoned.into_inner())
-                .solve_step(body, step, steps),
+            BodySolver::Nonlinear(newton) => newton.solve_step(body, step, steps),
         }
     }
 
@@ -44,10 +40,7 @@ impl BodySolver {
     pub fn solver_used(&self) -> &'static str {
         match self {
             BodySolver::Linear(eq) => eq.solver_used,
-            BodySolver::Nonlinear(newton) => newton
-                .lock()
-                .unwrap_or_else(|poisoned| poisoned.into_inner())
-                .solver_used(),
+            BodySolver::Nonlinear(newton) => newton.solver_used(),
         }
     }
 
@@ -55,13 +48,7 @@ impl BodySolver {
     pub fn free_dofs(&self) -> usize {
         match self {
             BodySolver::Linear(eq) => eq.assembly.n,
-            BodySolver::Nonlinear(newton) => {
-                newton
-                    .lock()
-                    .unwrap_or_else(|poisoned| poisoned.into_inner())
-                    .assembly
-                    .n
-            }
+            BodySolver::Nonlinear(newton) => newton.assembly.n,
         }
     }
 
@@ -69,12 +56,7 @@ impl BodySolver {
     pub fn times(&self) -> PhaseTimes {
         match self {
             BodySolver::Linear(eq) => eq.times,
-            BodySolver::Nonlinear(newton) => {
-                newton
-                    .lock()
-                    .unwrap_or_else(|poisoned| poisoned.into_inner())
-                    .times
-            }
+            BodySolver::Nonlinear(newton) => newton.times,
         }
     }
 }

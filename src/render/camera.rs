@@ -1,3 +1,5 @@
+//! The camera: where it looks from and how it projects points onto the frame.
+
 use crate::render::Projection;
 use crate::Real;
 use nalgebra::Vector3;

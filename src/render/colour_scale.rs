@@ -1,3 +1,5 @@
+//! Colours: the stress colour scale (compression blue, tension red) and the fixed colours of the drawing.
+
 use crate::Real;
 
 /// A colour with components from 0 to 1 (sRGB).

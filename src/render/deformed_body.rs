@@ -1,3 +1,5 @@
+//! One body at one step as it is drawn: undeformed and magnified deformed node positions.
+
 use crate::scene::{BodyResult, ModelBody};
 use crate::Real;
 use nalgebra::Vector3;

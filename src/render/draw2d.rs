@@ -1,3 +1,5 @@
+//! 2D bodies as line art: members coloured by stress, overloaded members black, the undeformed ghost.
+
 use crate::render::colour_scale::{ColourScale, BLACK, GHOST_GREY, PLAIN};
 use crate::render::deformed_body::DeformedBody;
 use crate::render::{Colouring, Layer, Primitive, View};

@@ -1,3 +1,5 @@
+//! 3D bodies as shaded surfaces coloured by the mean stress of the members at each node.
+
 use crate::render::colour_scale::{ColourScale, BLACK, GHOST_GREY, PLAIN_SURFACE};
 use crate::render::deformed_body::DeformedBody;
 use crate::render::draw2d::line_widths;

@@ -1,3 +1,5 @@
+//! Why pictures could not be made.
+
 use crate::scene::StoredRunError;
 use std::path::PathBuf;
 

@@ -1,5 +1,8 @@
+//! What stays fixed over the frames of a run: the box the camera fits, the magnification, the
+//! arrow scales and the colour ranges.
+
 use crate::render::draw3d::node_stresses;
-use crate::scene::{ModelFile, StepResult};
+use crate::scene::{ModelFile, RunResults, StepResult};
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -74,14 +77,36 @@ pub fn arrow_ends(
 }
 
 impl RunExtent {
-    /// Measure the stored `steps` of a run; `read` gives a step's results (it is called twice
-    /// per step: once for the largest values, once for the box at the chosen magnification).
+    /// Measure all stored steps of `run` (`magnification`: `None` for the automatic one).
+    pub fn of_run(run: &RunResults, magnification: Option<Real>) -> RunExtent {
+        let last_step = run.steps.last().map_or(0, |s| s.step);
+        Self::of_steps(&run.model, &run.steps, last_step, magnification)
+    }
+
+    /// Measure the stored steps `numbers` of a run of `model`; `read` gives a step's results
+    /// (called once per step; [`RunExtent::of_run`] takes results already in memory).
     pub fn measure<E>(
         model: &ModelFile,
-        steps: &[usize],
+        numbers: &[usize],
         magnification: Option<Real>,
-        mut read: impl FnMut(usize) -> Result<StepResult, E>,
+        read: impl FnMut(usize) -> Result<StepResult, E>,
     ) -> Result<RunExtent, E> {
+        let steps = numbers
+            .iter()
+            .copied()
+            .map(read)
+            .collect::<Result<Vec<_>, E>>()?;
+        let last_step = numbers.last().copied().unwrap_or(0);
+        Ok(Self::of_steps(model, &steps, last_step, magnification))
+    }
+
+    /// Measure `steps` of a run of `model`, the last stored being `last_step`.
+    fn of_steps(
+        model: &ModelFile,
+        steps: &[StepResult],
+        last_step: usize,
+        magnification: Option<Real>,
+    ) -> RunExtent {
         let undeformed: Vec<Vec<Vector3<Real>>> = model
             .bodies
             .iter()
@@ -107,8 +132,7 @@ impl RunExtent {
         let mut max_contact: Real = 0.0;
         let mut stress_limit: Real = 0.0;
         let mut node_stress_limit: Real = 0.0;
-        for &k in steps {
-            let r = read(k)?;
+        for r in steps {
             for (b, m) in r.bodies.iter().zip(&model.bodies) {
                 for u in &b.displacements {
                     max_displacement = max_displacement.max(vec3(u).norm());
@@ -141,8 +165,7 @@ impl RunExtent {
         } else {
             0.0
         };
-        for &k in steps {
-            let r = read(k)?;
+        for r in steps {
             for (i, b) in r.bodies.iter().enumerate() {
                 let (Some(nodes), Some(centre)) = (undeformed.get(i), centres.get(i)) else {
                     continue;
@@ -172,7 +195,7 @@ impl RunExtent {
         }
         // Room for support marks around the shape.
         let pad = Vector3::repeat(0.02 * size);
-        Ok(RunExtent {
+        RunExtent {
             is_3d: model.bodies.iter().any(|b| b.dimension == 3),
             size,
             max_displacement,
@@ -184,8 +207,8 @@ impl RunExtent {
             contact_scale,
             stress_limit,
             node_stress_limit,
-            last_step: steps.last().copied().unwrap_or(0),
-        })
+            last_step,
+        }
     }
 }
 

@@ -1,3 +1,5 @@
+//! One picture: an RGBA pixmap, and its PNG encoding.
+
 use crate::render::{RenderError, Rgb};
 use tiny_skia::{Color, Pixmap};
 

@@ -1,3 +1,5 @@
+//! The animated GIF of a run, built frame by frame in memory.
+
 use crate::render::{Frame, RenderError};
 
 /// An animated GIF built frame by frame in memory (each frame with its own 256-colour

@@ -1,3 +1,5 @@
+//! Marks drawn over the bodies: supports, applied forces and contact forces.
+
 use crate::render::colour_scale::{CONTACT_ORANGE, FORCE_BLUE};
 use crate::render::deformed_body::{vec3, DeformedBody};
 use crate::render::extent::arrow_ends;

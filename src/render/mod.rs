@@ -10,7 +10,7 @@ pub use self::options::{Colouring, Projection, RenderOptions, StepSelection};
 pub use self::picture::{camera_for, draw_frame, view_for, viewport_for};
 pub use self::primitives::{paint, Layer, Mesh, Primitive};
 pub use self::raster::{Lighting, RasterVertex, Rasteriser};
-pub use self::run_pictures::{render_run, select_steps, PictureWriter, RenderReport};
+pub use self::run_pictures::{draw_run, render_run, select_steps, PictureWriter, RenderReport};
 
 mod camera;
 mod colour_scale;

@@ -1,3 +1,5 @@
+//! What a picture is drawn with: frame size, camera, projection, colouring, steps.
+
 use crate::render::RenderError;
 use crate::scene::{PictureSettings, MAX_FRAME_SIDE};
 use crate::Real;

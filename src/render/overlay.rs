@@ -1,3 +1,5 @@
+//! The furniture of a frame: its layout, the colour bar and the labels.
+
 use crate::render::colour_scale::{colour_at, format_si, si_unit, BLACK, FORCE_BLUE, INK};
 use crate::render::text::{draw_text, text_width};
 use crate::render::{Frame, Rgb};

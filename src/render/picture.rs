@@ -1,3 +1,5 @@
+//! One frame of one step: camera and view for the run's extent, then the bodies drawn.
+
 use crate::render::colour_scale::{round_up, ColourScale};
 use crate::render::deformed_body::DeformedBody;
 use crate::render::draw2d::member_lines;

@@ -1,3 +1,5 @@
+//! What is drawn: lines, points and shaded meshes in model space, painted onto a frame.
+
 use crate::render::{Frame, Lighting, RasterVertex, Rasteriser, Rgb, View};
 use crate::Real;
 use nalgebra::Vector3;

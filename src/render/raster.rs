@@ -1,3 +1,5 @@
+//! The software rasteriser of shaded triangles: lighting and a depth buffer.
+
 /// Light for the shaded surfaces, in camera axes (x right, y up, z towards the viewer).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lighting {

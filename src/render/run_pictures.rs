@@ -1,8 +1,11 @@
+//! The pictures of a whole run: PNG frames and the GIF of its stored steps, drawn from its
+//! results in memory (during `linkage run`) or read back from a results folder (`linkage render`).
+
 use crate::atomic_file::write_atomically;
 use crate::render::{
     draw_frame, GifAnimation, RenderError, RenderOptions, RunExtent, StepSelection,
 };
-use crate::scene::{DrawResults, StoredRun, World};
+use crate::scene::{DrawResults, RunResults, StoredRun, World};
 use std::path::{Path, PathBuf};
 
 /// What [`render_run`] wrote.
@@ -20,16 +23,25 @@ pub struct RenderReport {
 
 /// The stored steps `selection` picks from `run`.
 pub fn select_steps(run: &StoredRun, selection: &StepSelection) -> Result<Vec<usize>, RenderError> {
+    pick_steps(&run.steps, &run.dir, selection)
+}
+
+/// The steps `selection` picks from the `stored` ones of the results folder `dir`.
+fn pick_steps(
+    stored: &[usize],
+    dir: &Path,
+    selection: &StepSelection,
+) -> Result<Vec<usize>, RenderError> {
     Ok(match selection {
-        StepSelection::All => run.steps.clone(),
-        StepSelection::Last => run.steps.last().copied().into_iter().collect(),
+        StepSelection::All => stored.to_vec(),
+        StepSelection::Last => stored.last().copied().into_iter().collect(),
         StepSelection::List(list) => {
             for &k in list {
-                if !run.steps.contains(&k) {
+                if !stored.contains(&k) {
                     return Err(RenderError::NoSuchStep {
                         step: k,
-                        dir: run.dir.clone(),
-                        stored: stored_list(&run.steps),
+                        dir: dir.to_path_buf(),
+                        stored: stored_list(stored),
                     });
                 }
             }
@@ -60,11 +72,23 @@ fn stored_list(steps: &[usize]) -> String {
 /// magnification, the force scale and the colour range are fixed over all stored steps.
 pub fn render_run(dir: &Path, options: &RenderOptions) -> Result<RenderReport, RenderError> {
     options.check()?;
-    let run = StoredRun::open(dir)?;
-    let steps = select_steps(&run, &options.steps)?;
-    let extent = RunExtent::measure(&run.model, &run.steps, options.magnification, |k| {
-        run.read_step(k)
-    })?;
+    let stored = StoredRun::open(dir)?;
+    // The selection is checked before the steps are read.
+    select_steps(&stored, &options.steps)?;
+    let run = stored.read_all()?;
+    draw_run(&run, dir, options)
+}
+
+/// Draw `run` into its results folder `dir` as [`render_run`] does: `png/NNNN.png` per step
+/// `options.steps` selects and `anim.gif` of them, as `options` ask.
+pub fn draw_run(
+    run: &RunResults,
+    dir: &Path,
+    options: &RenderOptions,
+) -> Result<RenderReport, RenderError> {
+    options.check()?;
+    let steps = pick_steps(&run.step_numbers(), dir, &options.steps)?;
+    let extent = RunExtent::of_run(run, options.magnification);
     let mut report = RenderReport {
         steps: steps.clone(),
         magnification: extent.magnification,
@@ -86,8 +110,12 @@ pub fn render_run(dir: &Path, options: &RenderOptions) -> Result<RenderReport, R
         None
     };
     for (i, &k) in steps.iter().enumerate() {
-        let result = run.read_step(k)?;
-        let frame = draw_frame(&run.model, &result, &extent, options)?;
+        let result = run.step(k).ok_or_else(|| RenderError::NoSuchStep {
+            step: k,
+            dir: dir.to_path_buf(),
+            stored: stored_list(&run.step_numbers()),
+        })?;
+        let frame = draw_frame(&run.model, result, &extent, options)?;
         if options.png {
             let path = png_dir.join(format!("{k:04}.png"));
             write_atomically(&path, &frame.png()?).map_err(|source| RenderError::Write {
@@ -117,9 +145,13 @@ pub fn render_run(dir: &Path, options: &RenderOptions) -> Result<RenderReport, R
 pub struct PictureWriter;
 
 impl DrawResults for PictureWriter {
-    fn draw(&self, world: &World, dir: &Path) -> Result<(), String> {
-        render_run(dir, &RenderOptions::from_settings(&world.pictures))
-            .map(|_| ())
-            .map_err(|e| e.to_string())
+    fn draw(
+        &self,
+        world: &World,
+        run: &RunResults,
+        dir: &Path,
+    ) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+        draw_run(run, dir, &RenderOptions::from_settings(&world.pictures))?;
+        Ok(())
     }
 }

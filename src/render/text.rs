@@ -1,3 +1,5 @@
+//! Text on frames, set in the bundled DejaVu Sans.
+
 use crate::render::Rgb;
 use std::sync::OnceLock;
 use tiny_skia::Pixmap;

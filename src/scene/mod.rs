@@ -1,30 +1,36 @@
 //! Scene files, the load-step driver and the result files.
 
 pub use self::build::{build_world, load_scene, SceneError};
-pub use self::extra_outputs::DrawResults;
+pub use self::driver::{run, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::results::{
     BodyResult, BodySize, ContactForce, NodeForce, PairForce, PhaseSeconds, StepResult,
     StepSummary, Summary,
 };
+pub use self::run_error::RunError;
+pub use self::run_results::RunResults;
 pub use self::selector::select_nodes;
-pub use self::simulation::{run, run_with, RunError, Simulation};
+pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
 pub use self::vtk::{write_vtk, VtkError};
 pub use self::world::{OutputSettings, World};
+pub use self::writers::DrawResults;
 
 mod build;
-mod extra_outputs;
+mod driver;
 mod mesh_file;
 mod model_file;
 mod obstacles;
 pub mod paper_files;
 mod pictures;
 mod results;
+mod run_error;
+mod run_results;
 mod selector;
 mod simulation;
 pub mod spec;
 mod stored_run;
 mod vtk;
 mod world;
+mod writers;

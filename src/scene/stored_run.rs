@@ -3,6 +3,7 @@
 
 use crate::scene::model_file::ModelFile;
 use crate::scene::results::StepResult;
+use crate::scene::run_results::RunResults;
 use std::path::{Path, PathBuf};
 
 /// Why a results folder cannot be read.
@@ -31,7 +32,8 @@ pub enum StoredRunError {
 const FOLDER_HINT: &str =
     "give a folder written by `linkage run SCENE --out DIR` (DIR/<scene name>)";
 
-/// A complete results folder: the model and the numbers of its stored steps.
+/// A complete results folder: the model and the numbers of its stored steps (the steps
+/// themselves are read by [`StoredRun::read_step`] or, all at once, [`StoredRun::read_all`]).
 #[derive(Clone, Debug)]
 pub struct StoredRun {
     /// The folder, `DIR/<scene>`.
@@ -120,5 +122,32 @@ impl StoredRun {
             return Err(StoredRunError::Bad { path, problem });
         }
         Ok(result)
+    }
+
+    /// Read every stored step into memory, each checked against the model and its file name.
+    pub fn read_all(self) -> Result<RunResults, StoredRunError> {
+        let mut steps = Vec::with_capacity(self.steps.len());
+        for &k in &self.steps {
+            let result = self.read_step(k)?;
+            if result.step != k {
+                return Err(StoredRunError::Bad {
+                    path: self.step_path(k),
+                    problem: format!("says step {} but is named for step {k}", result.step),
+                });
+            }
+            steps.push(result);
+        }
+        Ok(RunResults {
+            model: self.model,
+            steps,
+        })
+    }
+}
+
+impl RunResults {
+    /// Read the results folder `dir` (`DIR/<scene>`): [`StoredRun::open`], then
+    /// [`StoredRun::read_all`].
+    pub fn read(dir: &Path) -> Result<Self, StoredRunError> {
+        StoredRun::open(dir)?.read_all()
     }
 }

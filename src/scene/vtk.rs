@@ -1,5 +1,5 @@
-//! ParaView files of a stored run: `vtk/NNNN.vtu` per stored step (VTK XML unstructured grid,
-//! ASCII) and `vtk/<scene>.pvd`, the collection ParaView plays as the deformation process.
+//! ParaView files of a run's results: `vtk/NNNN.vtu` per stored step (VTK XML unstructured
+//! grid, ASCII) and `vtk/<scene>.pvd`, the collection ParaView plays as the deformation process.
 //!
 //! One `.vtu` holds every body of the scene: points are the deformed node positions (z = 0
 //! for 2D bodies), body after body; cells are the members as lines (VTK_LINE = 3), in member
@@ -19,19 +19,24 @@ use crate::atomic_file::write_atomically;
 use crate::contact::cut_by_z0;
 use crate::scene::model_file::{ModelBody, ModelFile};
 use crate::scene::results::{BodyResult, StepResult};
-use crate::scene::stored_run::{StoredRun, StoredRunError};
+use crate::scene::run_results::RunResults;
 use crate::Real;
 use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Why VTK files could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum VtkError {
-    /// A stored step could not be read.
-    #[error(transparent)]
-    Read(#[from] StoredRunError),
+    /// The model does not fit its obstacles' steps (a `model.json` edited or torn).
+    #[error("{path}: {problem}; run the scene again with `linkage run`")]
+    BadModel {
+        /// `model.json` of the results folder.
+        path: PathBuf,
+        /// What is wrong.
+        problem: String,
+    },
     /// A file could not be written.
     #[error("{path}: cannot write: {source}")]
     Write {
@@ -42,23 +47,25 @@ pub enum VtkError {
     },
 }
 
-/// Write `vtk/NNNN.vtu` for every stored step of `run` and `vtk/<scene>.pvd`, and with
-/// obstacles `vtk/obstacles_NNNN.vtu` (part 1 of the collection). The collection's
-/// `timestep` is the load factor when it grows strictly over the stored steps, else the step
-/// number (ParaView needs increasing times). Returns the files written.
-pub fn write_vtk(run: &StoredRun) -> Result<Vec<PathBuf>, VtkError> {
-    let dir = run.dir.join("vtk");
+/// Write `dir/vtk/NNNN.vtu` for every stored step of `run` and `dir/vtk/<scene>.pvd`, and
+/// with obstacles `dir/vtk/obstacles_NNNN.vtu` (part 1 of the collection); `dir` is the
+/// results folder (`DIR/<scene>`). The collection's `timestep` is the load factor when it
+/// grows strictly over the stored steps, else the step number (ParaView needs increasing
+/// times). Returns the files written.
+pub fn write_vtk(run: &RunResults, dir: &Path) -> Result<Vec<PathBuf>, VtkError> {
+    let results_dir = dir;
+    let dir = results_dir.join("vtk");
     std::fs::create_dir_all(&dir).map_err(|source| VtkError::Write {
         path: dir.clone(),
         source,
     })?;
     let mut written = Vec::new();
     let mut entries = Vec::new();
-    for &step in &run.steps {
-        let result = run.read_step(step)?;
+    for result in &run.steps {
+        let step = result.step;
         let name = format!("{step:04}.vtu");
         let path = dir.join(&name);
-        write_atomically(&path, vtu_text(&run.model.bodies, &result).as_bytes()).map_err(
+        write_atomically(&path, vtu_text(&run.model.bodies, result).as_bytes()).map_err(
             |source| VtkError::Write {
                 path: path.clone(),
                 source,
@@ -69,10 +76,11 @@ pub fn write_vtk(run: &StoredRun) -> Result<Vec<PathBuf>, VtkError> {
     }
     let mut obstacle_files = Vec::new();
     if !run.model.obstacles.is_empty() {
-        for &step in &run.steps {
+        for result in &run.steps {
+            let step = result.step;
             let text =
-                obstacles_vtu_text(&run.model, step).map_err(|problem| StoredRunError::Bad {
-                    path: run.dir.join("model.json"),
+                obstacles_vtu_text(&run.model, step).map_err(|problem| VtkError::BadModel {
+                    path: results_dir.join("model.json"),
                     problem,
                 })?;
             let name = format!("obstacles_{step:04}.vtu");

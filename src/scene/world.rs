@@ -1,3 +1,5 @@
+//! What one run needs, built and checked from a scene file: bodies, obstacles, contact and output settings.
+
 use crate::contact::{ContactSettings, Obstacle};
 use crate::linkage::{Body, Schedule};
 use crate::scene::PictureSettings;
@@ -74,5 +76,21 @@ impl World {
             Some(first) if schedules.all(|s| s == first) => first.factor(step, self.steps),
             _ => Schedule::Linear.factor(step, self.steps),
         }
+    }
+
+    /// The model's size in one line, as `linkage run` and `linkage check` print it: bodies,
+    /// nodes, members, patches, DOFs and load steps.
+    pub fn describe(&self) -> String {
+        let nodes: usize = self.bodies.iter().map(|b| b.nodes.len()).sum();
+        let members: usize = self.bodies.iter().map(|b| b.members.len()).sum();
+        let patches: usize = self.bodies.iter().map(|b| b.patches.len()).sum();
+        let dofs: usize = self.bodies.iter().map(|b| b.dof_count()).sum();
+        format!(
+            "{} bod{}, {nodes} nodes, {members} members, {patches} patches, {dofs} DOFs, {} step{}",
+            self.bodies.len(),
+            if self.bodies.len() == 1 { "y" } else { "ies" },
+            self.steps,
+            if self.steps == 1 { "" } else { "s" }
+        )
     }
 }

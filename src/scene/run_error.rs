@@ -1,0 +1,43 @@
+//! Why a run stopped: the one error type of the load-step driver and its writers.
+
+use crate::contact::ContactError;
+use crate::linkage::SolveError;
+use std::path::PathBuf;
+
+/// Why a run stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// A body could not be solved.
+    #[error("{scene}: {source}")]
+    Solve {
+        /// Scene file.
+        scene: PathBuf,
+        /// What went wrong.
+        source: SolveError,
+    },
+    /// The bodies in contact could not be solved.
+    #[error("{scene}: {source}")]
+    Contact {
+        /// Scene file.
+        scene: PathBuf,
+        /// What went wrong.
+        source: ContactError,
+    },
+    /// A result file could not be written.
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        /// File or folder.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Pictures or VTK files could not be made.
+    #[error("{path}: {source}")]
+    Draw {
+        /// Results folder or file.
+        path: PathBuf,
+        /// What went wrong and what to do: the writer's own error (a
+        /// [`crate::scene::VtkError`], or the picture writer's).
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+}
