@@ -63,7 +63,7 @@ fn the_good_case_solves() {
     )))
     .unwrap();
     assert_eq!(world.steps, 1);
-    let sim = Simulation::new(&world).unwrap_or_else(|e| panic!("{e}"));
+    let mut sim = Simulation::new(&world).unwrap_or_else(|e| panic!("{e}"));
     let (step, summary) = sim.step(1).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!((step.step, step.load_factor), (1, 1.0));
     assert!(summary.residual <= 1e-9, "residual {}", summary.residual);
