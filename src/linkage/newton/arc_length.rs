@@ -2,7 +2,7 @@
 //! increment keeps the length of the free displacement increment, which follows the path
 //! through limit points.
 
-use super::{not_converged, IncrementFailure, IncrementSize, NewtonEquilibrium};
+use super::{IncrementFailure, IncrementSize, NewtonEquilibrium};
 use crate::linkage::body_state::{full_loads, norm};
 use crate::linkage::step_state::force_scale;
 use crate::linkage::{Body, Convergence, SolveError};
@@ -32,9 +32,7 @@ impl NewtonEquilibrium {
                 Err(failure) => {
                     iterations += failure.solves;
                     (self.u, self.lambda, self.previous) = (u0, l0, p0);
-                    if !size.failed(body.newton.max_cuts) {
-                        return Err(not_converged(body, target, &size, failure));
-                    }
+                    size.retry(body, target, failure)?;
                 }
             }
         }

@@ -2,7 +2,7 @@
 //! increments halved when Newton does not converge; each increment starts from the path
 //! extrapolated through the last converged states when that is closer to equilibrium.
 
-use super::{not_converged, IncrementFailure, IncrementSize, NewtonEquilibrium, PATH_POINTS};
+use super::{IncrementFailure, IncrementSize, NewtonEquilibrium, PATH_POINTS};
 use crate::linkage::body_state::{norm, prescribed_at, tangent_times};
 use crate::linkage::step_state::force_scale;
 use crate::linkage::{Body, Convergence, SolveError};
@@ -42,9 +42,7 @@ impl NewtonEquilibrium {
                 Err(failure) => {
                     iterations += failure.solves;
                     self.u = saved;
-                    if !size.failed(body.newton.max_cuts) {
-                        return Err(not_converged(body, target, &size, failure));
-                    }
+                    size.retry(body, target, failure)?;
                 }
             }
         }

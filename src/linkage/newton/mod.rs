@@ -402,6 +402,20 @@ impl IncrementSize {
         self.cuts += 1;
         true
     }
+    /// After `failure` of an increment of step `step`: halve, or give the step's error when
+    /// the increment is already the smallest allowed.
+    fn retry(
+        &mut self,
+        body: &Body,
+        step: usize,
+        failure: IncrementFailure,
+    ) -> Result<(), SolveError> {
+        if self.failed(body.newton.max_cuts) {
+            Ok(())
+        } else {
+            Err(not_converged(body, step, self, failure))
+        }
+    }
 }
 
 /// The error for a step that could not be solved even with the smallest increment.
