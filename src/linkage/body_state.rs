@@ -1,5 +1,7 @@
-//! One body at a displacement field: node vectors, member responses, internal forces `K·u`,
-//! the tangent, and the loads and prescribed displacements at a pseudo-time.
+//! One body at a displacement field: the kernel every solver evaluates a body through.
+//!
+//! Node vectors, member responses, internal forces `K·u`, the tangent, and the loads and
+//! prescribed displacements at a pseudo-time.
 //!
 //! Every solver of the crate (the linear solve, the Newton solves, contact) evaluates a body
 //! through these functions. A displacement field is one value per body DOF (`d` per node, node

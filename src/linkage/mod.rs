@@ -1,5 +1,4 @@
-//! One body: its nodes, members, patches, supports and loads; the linear solve of the paper and
-//! the Newton solve for large displacements, cables and struts.
+//! The paper's linkage model of one body and its equilibrium, linear and nonlinear.
 
 pub use self::assembly::ModelTooLarge;
 pub use self::assembly::StiffnessAssembly;

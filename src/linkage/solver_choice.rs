@@ -1,5 +1,6 @@
-//! Which linear solver a body's stiffness gets: the choice a scene makes, its settings, and
-//! the solver that was used in the end.
+//! Which linear solver a body's stiffness gets, and which one it got.
+//!
+//! The choice a scene makes, its settings, and the solver that was used in the end.
 
 use crate::Real;
 use std::fmt;

@@ -1,5 +1,6 @@
-//! The solved state of a body at one step, and its post-processing from a displacement field:
-//! shared by the linear solve ([`crate::linkage::Equilibrium`]) and the Newton solve.
+//! The solved state of a body at one step, and its post-processing from a displacement field.
+//!
+//! Shared by the linear solve ([`crate::linkage::Equilibrium`]) and the Newton solve.
 
 use crate::linkage::body_state::{node_vector, norm};
 use crate::linkage::{Body, Convergence, DofMap, DofSlot};

@@ -1,6 +1,7 @@
-//! Crisfield's cylindrical arc-length method: the load factor is an unknown, and each
-//! increment keeps the length of the free displacement increment, which follows the path
-//! through limit points.
+//! Crisfield's cylindrical arc-length method, which follows the path through limit points.
+//!
+//! The load factor is an unknown, and each increment keeps the length of the free
+//! displacement increment.
 
 use super::{IncrementFailure, IncrementSize, NewtonEquilibrium};
 use crate::linkage::body_state::{full_loads, norm};

@@ -1,6 +1,8 @@
-//! Load control: each step's loads and prescribed displacements follow their schedules, in
-//! increments halved when Newton does not converge; each increment starts from the path
-//! extrapolated through the last converged states when that is closer to equilibrium.
+//! Load control: each step's loads and prescribed displacements follow their schedules.
+//!
+//! A step is crossed in increments halved when Newton does not converge; each increment starts
+//! from the path extrapolated through the last converged states when that is closer to
+//! equilibrium.
 
 use super::{IncrementFailure, IncrementSize, NewtonEquilibrium, PATH_POINTS};
 use crate::linkage::body_state::{norm, prescribed_at, tangent_times};

@@ -1,6 +1,8 @@
-//! Newton–Raphson equilibrium of a nonlinear body (large kinematics, cables, struts), load
-//! step by load step, with a line search and automatic halving of increments that do not
-//! converge; or along an arc length (see [`crate::linkage::PathMethod`]).
+//! Newton–Raphson equilibrium of a nonlinear body: large kinematics, cables, struts.
+//!
+//! Load step by load step (`load_control`), with a line search and automatic halving of
+//! increments that do not converge; or along an arc length (`arc_length`; see
+//! [`crate::linkage::PathMethod`]).
 //!
 //! At every iteration the tangent stiffness is refilled in the pattern computed once
 //! ([`StiffnessAssembly::fill`]) and refactored on the symbolic factorization computed once.
