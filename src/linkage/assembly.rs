@@ -1,3 +1,5 @@
+//! The sparse pattern of `K_ff` (paper Eq. 3–4), computed once, and its refill member by member.
+
 use crate::linkage::{Body, DofMap, DofSlot};
 use crate::Real;
 use nalgebra::Matrix3;

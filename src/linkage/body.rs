@@ -1,3 +1,5 @@
+//! One body: its nodes, members, patches, materials, supports and loads, and their checks.
+
 use crate::linkage::{Geometry, Kinematics, Material, NewtonSettings, PathMethod, SolverSettings};
 use crate::Real;
 use nalgebra::Vector3;

@@ -1,6 +1,8 @@
 //! The solver a body needs: the paper's linear superposition, or Newton for a nonlinear body.
 
-use crate::linkage::{Body, Equilibrium, NewtonEquilibrium, PhaseTimes, SolveError, StepState};
+use crate::linkage::{
+    Body, Equilibrium, NewtonEquilibrium, PhaseTimes, SolveError, SolverUsed, StepState,
+};
 
 /// One body's equilibrium solver, chosen by [`Body::is_nonlinear`].
 pub enum BodySolver {
@@ -35,9 +37,9 @@ impl BodySolver {
         }
     }
 
-    /// Which linear solver produced the answers: "direct", "iterative", or "iterative, then
-    /// direct" when conjugate gradients did not converge on a linear body.
-    pub fn solver_used(&self) -> &'static str {
+    /// Which linear solver produced the answers: direct, iterative, or iterative then direct
+    /// when conjugate gradients did not converge on a linear body.
+    pub fn solver_used(&self) -> SolverUsed {
         match self {
             BodySolver::Linear(eq) => eq.solver_used,
             BodySolver::Nonlinear(newton) => newton.solver_used(),

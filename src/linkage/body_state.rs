@@ -1,5 +1,7 @@
-//! One body at a displacement field: node vectors, member responses, internal forces `K·u`,
-//! the tangent, and the loads and prescribed displacements at a pseudo-time.
+//! One body at a displacement field: the kernel every solver evaluates a body through.
+//!
+//! Node vectors, member responses, internal forces `K·u`, the tangent, and the loads and
+//! prescribed displacements at a pseudo-time.
 //!
 //! Every solver of the crate (the linear solve, the Newton solves, contact) evaluates a body
 //! through these functions. A displacement field is one value per body DOF (`d` per node, node
@@ -67,13 +69,22 @@ pub fn linear_internal_forces(body: &Body, stiffness: &[Real], u: &[Real], out: 
     for (m, member) in body.members.iter().enumerate() {
         let [a, b] = member.nodes;
         let n = undeformed_axis(body, a, b);
-        let stretch: Real = (0..d).map(|k| n[k] * (u[b * d + k] - u[a * d + k])).sum();
-        let force = stiffness[m] * stretch;
+        let force = stiffness[m] * linear_stretch(u, d, [a, b], &n);
         for k in 0..d {
             out[a * d + k] -= force * n[k];
             out[b * d + k] += force * n[k];
         }
     }
+}
+
+/// The stretch of the member between `nodes` in the paper's linear model, m: the displacement
+/// `u` (per body DOF, `d` per node) of its second end relative to its first, along its
+/// undeformed unit `axis`.
+pub fn linear_stretch(u: &[Real], d: usize, nodes: [usize; 2], axis: &Vector3<Real>) -> Real {
+    let [a, b] = nodes;
+    (0..d)
+        .map(|k| axis[k] * (u[b * d + k] - u[a * d + k]))
+        .sum()
 }
 
 /// The unit vector from node `a` to node `b` of the undeformed body.

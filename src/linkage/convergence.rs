@@ -1,5 +1,6 @@
-//! The convergence monitor of every Newton iteration in the crate: the relative residual, its
-//! history, finiteness, and the round-off floor where it stalls.
+//! The convergence monitor of every Newton iteration in the crate.
+//!
+//! The relative residual, its history, finiteness, and the round-off floor where it stalls.
 
 use crate::Real;
 

@@ -1,3 +1,5 @@
+//! The partition of a body's DOFs into free and supported ones (paper Eq. 5).
+
 use crate::linkage::Body;
 
 /// Where one degree of freedom of a body goes in the partitioned system of paper Eq. 5.

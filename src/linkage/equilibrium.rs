@@ -1,11 +1,14 @@
+//! The paper's linear equilibrium (Eq. 5–10), the phase times and the errors of every body solve.
+
 use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
 use crate::linkage::assembly::ModelTooLarge;
-use crate::linkage::body_state::{linear_internal_forces, undeformed_axis};
+use crate::linkage::body_state::{linear_internal_forces, linear_stretch, undeformed_axis};
 use crate::linkage::iterative_solver::IterativeSolver;
 use crate::linkage::mechanism::{diagnose_mechanism, Mechanism};
 use crate::linkage::step_state::post_process;
 use crate::linkage::{
-    axial_stiffness, member_block, Body, BodyError, DofMap, Schedule, StepState, StiffnessAssembly,
+    axial_stiffness, member_block, Body, BodyError, DofMap, Schedule, SolverUsed, StepState,
+    StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
@@ -111,9 +114,9 @@ pub struct Equilibrium {
     pub times: PhaseTimes,
     /// Entries of the Cholesky factor (0 when nothing is free or solved iteratively).
     pub factor_entries: usize,
-    /// Which solver produced the answer: "direct", "iterative", or "iterative, then direct"
-    /// when conjugate gradients did not converge.
-    pub solver_used: &'static str,
+    /// Which solver produced the answer: direct, iterative, or iterative then direct when
+    /// conjugate gradients did not converge.
+    pub solver_used: SolverUsed,
     /// Conjugate-gradient iterations, all load patterns.
     pub linear_iterations: usize,
     patterns: Vec<LoadPattern>,
@@ -154,7 +157,7 @@ impl Equilibrium {
             values,
             times,
             factor_entries: 0,
-            solver_used: "direct",
+            solver_used: SolverUsed::Direct,
             linear_iterations: 0,
             patterns: Vec::new(),
             stiffness,
@@ -193,12 +196,12 @@ impl Equilibrium {
             eq.linear_iterations = it.iterations;
             if let Some(patterns) = patterns {
                 eq.patterns = patterns;
-                eq.solver_used = "iterative";
+                eq.solver_used = SolverUsed::Iterative;
                 return Ok(eq);
             }
             // Conjugate gradients failed: the direct solver decides (and names a mechanism).
             fell_back = failure;
-            eq.solver_used = "iterative, then direct";
+            eq.solver_used = SolverUsed::IterativeThenDirect;
         }
         let mut cholesky = None;
         if eq.assembly.n > 0 {
@@ -349,7 +352,7 @@ impl Equilibrium {
         let members = body.members.iter().enumerate().map(|(m, member)| {
             let [a, b] = member.nodes;
             let n = undeformed_axis(body, a, b);
-            let stretch: Real = (0..d).map(|k| n[k] * (u[b * d + k] - u[a * d + k])).sum();
+            let stretch = linear_stretch(&u, d, [a, b], &n);
             let strain = stretch / body.member_length(m);
             let material = &body.materials[member.material];
             (strain, material.youngs_modulus * strain * material.area)

@@ -1,3 +1,5 @@
+//! The shape of a linkage without materials, supports or loads.
+
 use crate::linkage::Dimension;
 use crate::Real;
 use nalgebra::Vector3;

@@ -1,3 +1,5 @@
+//! A member's material and section: Young's modulus, area, strength, and which sign it carries.
+
 use crate::Real;
 
 /// Which sign of axial force a member can carry.

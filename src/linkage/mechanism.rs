@@ -1,5 +1,7 @@
-//! Naming the nodes of a mechanism: when `K_ff` is singular, find a displacement mode that
-//! stretches no member and report which nodes it moves, in which directions.
+//! Naming the nodes of a mechanism when `K_ff` is singular.
+//!
+//! Find a displacement mode that stretches no member and report which nodes it moves, in
+//! which directions.
 
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linkage::{direction_name, Body, DofMap, StiffnessAssembly};

@@ -1,5 +1,6 @@
-//! One member's axial force and tangent stiffness at a displacement state, for both
-//! kinematics and every material behaviour.
+//! One member's axial force and tangent stiffness at a displacement state.
+//!
+//! For both kinematics and every material behaviour.
 
 use crate::linkage::{Kinematics, Material};
 use crate::Real;

@@ -1,3 +1,5 @@
+//! The stiffness of one member (paper Eq. 1–2): `AE/L` and its block in global axes.
+
 use crate::linkage::{Dimension, Material};
 use crate::Real;
 use nalgebra::{DMatrix, Matrix3, Vector3};

@@ -1,5 +1,4 @@
-//! One body: its nodes, members, patches, supports and loads; the linear solve of the paper and
-//! the Newton solve for large displacements, cables and struts.
+//! The paper's linkage model of one body and its equilibrium, linear and nonlinear.
 
 pub use self::assembly::ModelTooLarge;
 pub use self::assembly::StiffnessAssembly;
@@ -19,7 +18,8 @@ pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
 pub use self::newton::NewtonEquilibrium;
 pub use self::solver_choice::{
-    IterativeSettings, SolverChoice, SolverSettings, AUTO_ITERATIVE_DOFS_2D, AUTO_ITERATIVE_DOFS_3D,
+    IterativeSettings, SolverChoice, SolverSettings, SolverUsed, AUTO_ITERATIVE_DOFS_2D,
+    AUTO_ITERATIVE_DOFS_3D,
 };
 pub(crate) use self::step_state::post_process;
 pub use self::step_state::StepState;

@@ -1,4 +1,9 @@
+//! Which linear solver a body's stiffness gets, and which one it got.
+//!
+//! The choice a scene makes, its settings, and the solver that was used in the end.
+
 use crate::Real;
+use std::fmt;
 
 /// Which linear solver a body's `K_ff` gets.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -70,5 +75,39 @@ impl SolverSettings {
                 free_dofs > limit
             }
         }
+    }
+}
+
+/// The linear solver that produced a body's answers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SolverUsed {
+    /// Sparse Cholesky or LDLᵀ.
+    Direct,
+    /// Conjugate gradients with multigrid.
+    Iterative,
+    /// Conjugate gradients did not converge on a linear body, and the direct solver answered.
+    IterativeThenDirect,
+}
+
+impl SolverUsed {
+    /// The name `summary.json` gives it: "direct", "iterative" or "iterative, then direct".
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SolverUsed::Direct => "direct",
+            SolverUsed::Iterative => "iterative",
+            SolverUsed::IterativeThenDirect => "iterative, then direct",
+        }
+    }
+}
+
+impl fmt::Display for SolverUsed {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl PartialEq<&str> for SolverUsed {
+    fn eq(&self, other: &&str) -> bool {
+        self.as_str() == *other
     }
 }

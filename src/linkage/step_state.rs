@@ -1,7 +1,9 @@
-//! The solved state of a body at one step, and its post-processing from a displacement field:
-//! shared by the linear solve ([`crate::linkage::Equilibrium`]) and the Newton solve.
+//! The solved state of a body at one step, and its post-processing from a displacement field.
+//!
+//! Shared by the linear solve ([`crate::linkage::Equilibrium`]) and the Newton solve.
 
-use crate::linkage::{Body, DofMap, DofSlot};
+use crate::linkage::body_state::{node_vector, norm};
+use crate::linkage::{Body, Convergence, DofMap, DofSlot};
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -60,13 +62,7 @@ pub(crate) fn post_process(
     let d = dofs.dofs_per_node;
     let mut state = StepState {
         displacements: (0..body.nodes.len())
-            .map(|i| {
-                let mut v = Vector3::zeros();
-                for k in 0..d {
-                    v[k] = u[i * d + k];
-                }
-                v
-            })
+            .map(|i| node_vector(u, d, i))
             .collect(),
         ..Default::default()
     };
@@ -112,30 +108,26 @@ pub(crate) fn post_process(
 /// forces and the norm of the reactions (`internal − forces` at the supported DOFs); 0 when
 /// both are zero.
 pub(crate) fn relative_residual(dofs: &DofMap, forces: &[Real], internal: &[Real]) -> Real {
-    let out_of_balance: Real = dofs
-        .free
-        .iter()
-        .map(|&dof| (internal[dof] - forces[dof]).powi(2))
-        .sum::<Real>()
-        .sqrt();
-    let scale = force_scale(dofs, forces, internal);
-    if scale > 0.0 {
-        out_of_balance / scale
-    } else if out_of_balance > 0.0 {
-        Real::INFINITY
-    } else {
-        0.0
-    }
+    let out_of_balance = free_out_of_balance(dofs, forces, internal);
+    Convergence::relative(out_of_balance, force_scale(dofs, forces, internal))
 }
 
 /// The larger of the applied force norm and the reaction norm, N: what "relative" refers to.
 pub(crate) fn force_scale(dofs: &DofMap, forces: &[Real], internal: &[Real]) -> Real {
-    let applied = forces.iter().map(|f| f * f).sum::<Real>().sqrt();
-    let reacted = dofs
-        .supported
-        .iter()
+    let applied = norm(forces);
+    let reacted = difference_norm(&dofs.supported, forces, internal);
+    applied.max(reacted)
+}
+
+/// `|internal − forces|` over the free DOFs, N: the out-of-balance force.
+pub(crate) fn free_out_of_balance(dofs: &DofMap, forces: &[Real], internal: &[Real]) -> Real {
+    difference_norm(&dofs.free, forces, internal)
+}
+
+/// `|internal − forces|` over the body DOFs `over`, N.
+fn difference_norm(over: &[usize], forces: &[Real], internal: &[Real]) -> Real {
+    over.iter()
         .map(|&dof| (internal[dof] - forces[dof]).powi(2))
         .sum::<Real>()
-        .sqrt();
-    applied.max(reacted)
+        .sqrt()
 }

@@ -1,5 +1,6 @@
-//! Factor and solve the tangent stiffness `K_ff` of a nonlinear body, iteration after
-//! iteration on one sparse pattern: the ordering and symbolic factorization are done once,
+//! Factor and solve the tangent stiffness `K_ff` of a nonlinear body, iteration after iteration.
+//!
+//! One sparse pattern: the ordering and symbolic factorization are done once,
 //! every iteration refactors the values only. A tangent that is not positive definite (past a
 //! limit point) is factored by LDLᵀ on the same ordering, which also counts its negative pivots.
 //! A large body may instead be solved by multigrid conjugate gradients, warm-started, with the

@@ -1,3 +1,5 @@
+//! A box lattice: cubic cells whose nodes are joined to all their neighbours, and its boundary patches.
+
 use super::error::{allocate, check_count, check_length, sum_of_products};
 use super::GeneratorError;
 use crate::linkage::{Dimension, Geometry};

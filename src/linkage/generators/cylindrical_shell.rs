@@ -1,3 +1,5 @@
+//! The cylindrical shell of the paper's Fig. 7.
+
 use super::error::{allocate, check_count, check_length, sum_of_products};
 use super::GeneratorError;
 use crate::linkage::{Dimension, Geometry};

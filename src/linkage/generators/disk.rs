@@ -1,3 +1,5 @@
+//! The circular disk of the paper's Fig. 1.
+
 use super::error::{allocate, check_count, check_length, sum_of_products};
 use super::GeneratorError;
 use crate::linkage::{Dimension, Geometry};

@@ -1,3 +1,5 @@
+//! Why a generator cannot build the shape asked for.
+
 use crate::Real;
 
 /// Why a generator cannot build the shape asked for.

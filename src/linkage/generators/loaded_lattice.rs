@@ -1,5 +1,6 @@
-//! Loaded box lattices for the solver tests and benchmarks: the bottom face clamped, a force
-//! shared by the top face.
+//! Loaded box lattices for the solver tests and benchmarks.
+//!
+//! The bottom face clamped, a force shared by the top face.
 
 use crate::linkage::generators::{box_lattice, GeneratorError};
 use crate::linkage::{Body, Material, NodalLoad, Schedule, Support};

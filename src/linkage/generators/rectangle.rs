@@ -1,3 +1,5 @@
+//! The 2D rectangle of the paper's Fig. 4–6, cells with both diagonals.
+
 use super::error::{allocate, check_count, check_length, sum_of_products};
 use super::GeneratorError;
 use crate::linkage::{Dimension, Geometry};

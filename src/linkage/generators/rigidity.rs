@@ -1,5 +1,6 @@
-//! Test-only checks shared by the generators: rigidity once supported, small solves,
-//! outward patches, patch edges being members.
+//! Test-only checks shared by the generators.
+//!
+//! Rigidity once supported, small solves, outward patches, patch edges being members.
 
 use crate::linkage::{check_members, Geometry};
 use crate::Real;

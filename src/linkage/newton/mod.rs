@@ -1,0 +1,438 @@
+//! Newton–Raphson equilibrium of a nonlinear body: large kinematics, cables, struts.
+//!
+//! Load step by load step (`load_control`), with a line search and automatic halving of
+//! increments that do not converge; or along an arc length (`arc_length`; see
+//! [`crate::linkage::PathMethod`]).
+//!
+//! At every iteration the tangent stiffness is refilled in the pattern computed once
+//! ([`StiffnessAssembly::fill`]) and refactored on the symbolic factorization computed once.
+//! Under load control each increment starts from the path extrapolated through the last
+//! converged states when that is closer to equilibrium, which saves the predictor's solve.
+
+use crate::linkage::body_state::{
+    fill_tangent, full_loads, internal_forces, loads_at, member_response_at, norm,
+};
+use crate::linkage::line_search::backtrack;
+use crate::linkage::mechanism::diagnose_mechanism;
+use crate::linkage::step_state::{force_scale, free_out_of_balance, post_process};
+use crate::linkage::tangent_solver::{TangentError, TangentSolver};
+use crate::linkage::{
+    direction_name, Body, Convergence, DofMap, PathMethod, PhaseTimes, SolveError, SolverUsed,
+    StepState, StiffnessAssembly,
+};
+use crate::Real;
+use std::time::Instant;
+
+mod arc_length;
+mod load_control;
+
+/// Why one load increment failed (the step is retried with half the increment).
+#[derive(Clone, Debug)]
+struct IncrementFailure {
+    reason: String,
+    history: Vec<Real>,
+    /// Tangent solves made (one fewer than residuals when it started from an extrapolation).
+    solves: usize,
+}
+
+/// The nonlinear equilibrium of one body, advanced step by step. Holds the current
+/// displacement field between steps.
+///
+/// ```
+/// use linkage::linkage::{Body, Dimension, Kinematics, Material, Member, NewtonEquilibrium, Schedule, Support};
+/// use nalgebra::Vector3;
+///
+/// // A bar 1 m long along x pulled to twice its length by its end support.
+/// let mut body = Body::new("bar", Dimension::Two);
+/// body.materials.push(Material::new("rubber", 1e7, 1e-4));
+/// body.nodes = vec![Vector3::zeros(), Vector3::new(1.0, 0.0, 0.0)];
+/// body.members.push(Member { nodes: [0, 1], material: 0 });
+/// body.supports.push(Support::fixed(0, [true, true, false]));
+/// body.supports.push(Support {
+///     node: 1,
+///     fixed: [true, true, false],
+///     displacement: Vector3::new(1.0, 0.0, 0.0),
+///     schedule: Schedule::Linear,
+/// });
+/// body.kinematics = Kinematics::Large;
+/// let mut newton = NewtonEquilibrium::new(&body).unwrap();
+/// let state = newton.solve_step(&body, 1, 1).unwrap();
+/// // Engineering strain (2L − L)/L = 1, so N = E A.
+/// assert!((state.axial_forces[0] - 1e7 * 1e-4).abs() < 1e-9);
+/// ```
+pub struct NewtonEquilibrium {
+    /// The free/support partition.
+    pub dofs: DofMap,
+    /// The pattern of `K_ff` and the place of each member entry.
+    pub assembly: StiffnessAssembly,
+    /// Time spent in each phase so far, s (assembly: tangent refills and internal forces).
+    pub times: PhaseTimes,
+    /// Entries of the factor of the tangent.
+    pub factor_entries: usize,
+    /// Relative residual after each Newton iteration of the last increment solved (the
+    /// quadratic convergence shows here); when the increment started from the extrapolated
+    /// path, the first entry is the residual there, before any correction.
+    pub residual_history: Vec<Real>,
+    solver: Option<TangentSolver>,
+    values: Vec<Real>,
+    /// Displacement per body DOF at the last solved step, m.
+    u: Vec<Real>,
+    /// Load factor at the last solved step (arc length).
+    lambda: Real,
+    /// The step `u` belongs to.
+    step: usize,
+    /// The last converged increment of the free DOFs (arc length: keeps the path direction).
+    previous: Vec<Real>,
+    /// Negative pivots of the last factored tangent.
+    negative_pivots: usize,
+    /// The largest force scale (applied or reaction norm, N) and displacement norm (m) of the
+    /// states converged so far: floors of what "relative" refers to, so that unloading back to
+    /// zero (where both vanish) still converges.
+    force_floor: Real,
+    displacement_floor: Real,
+    /// The last converged states of the load path (pseudo-time, displacement per body DOF),
+    /// newest last, at most [`PATH_POINTS`]: the next increment starts from their
+    /// extrapolation.
+    path: Vec<(Real, Vec<Real>)>,
+}
+
+/// Converged states kept for the extrapolation (three: up to a quadratic through them).
+const PATH_POINTS: usize = 3;
+
+impl NewtonEquilibrium {
+    /// Validate `body`, build its pattern, analyze it once and check that the undeformed
+    /// tangent is not singular (a mechanism is reported with its nodes).
+    pub fn new(body: &Body) -> Result<Self, SolveError> {
+        body.validate()?;
+        let t = Instant::now();
+        let dofs = DofMap::new(body);
+        let assembly = StiffnessAssembly::new(body, &dofs)?;
+        let nd = body.dof_count();
+        let mut eq = NewtonEquilibrium {
+            previous: vec![0.0; assembly.n],
+            dofs,
+            assembly,
+            times: PhaseTimes::default(),
+            factor_entries: 0,
+            residual_history: Vec::new(),
+            solver: None,
+            values: Vec::new(),
+            u: vec![0.0; nd],
+            lambda: 0.0,
+            step: 0,
+            negative_pivots: 0,
+            force_floor: 0.0,
+            displacement_floor: 0.0,
+            path: vec![(0.0, vec![0.0; nd])],
+        };
+        eq.fill_tangent(body);
+        eq.times.assembly += t.elapsed().as_secs_f64();
+        if eq.assembly.n > 0 {
+            let t = Instant::now();
+            let solver = TangentSolver::new(body, &eq.dofs, &eq.assembly).map_err(|e| {
+                SolveError::Factorization {
+                    body: body.name.clone(),
+                    message: e.to_string(),
+                }
+            })?;
+            eq.times.symbolic += t.elapsed().as_secs_f64();
+            eq.solver = Some(solver);
+            let t = Instant::now();
+            let first = match eq.solver.as_mut() {
+                Some(s) => s.factorize_definite(&eq.values),
+                None => Ok(()),
+            };
+            eq.times.numeric += t.elapsed().as_secs_f64();
+            match first {
+                Ok(_) => {}
+                Err(TangentError::Indefinite { dof }) => {
+                    let solver = eq.solver.as_mut().and_then(|s| s.cholesky_mut());
+                    if let Some(c) = solver {
+                        return Err(SolveError::Mechanism(Box::new(diagnose_mechanism(
+                            body,
+                            &eq.dofs,
+                            &eq.assembly,
+                            &eq.values,
+                            c,
+                            dof,
+                        ))));
+                    }
+                }
+                Err(TangentError::Other(message)) => {
+                    return Err(SolveError::Factorization {
+                        body: body.name.clone(),
+                        message,
+                    })
+                }
+            }
+            eq.factor_entries = eq.solver.as_ref().map_or(0, |s| s.factor_entries());
+        }
+        Ok(eq)
+    }
+
+    /// Conjugate-gradient iterations so far (0 with the direct solver).
+    pub fn linear_iterations(&self) -> usize {
+        self.solver.as_ref().map_or(0, |s| s.iterations())
+    }
+
+    /// Which linear solver the tangent gets: direct or iterative.
+    pub fn solver_used(&self) -> SolverUsed {
+        if self.solver.as_ref().is_some_and(|s| s.is_iterative()) {
+            SolverUsed::Iterative
+        } else {
+            SolverUsed::Direct
+        }
+    }
+
+    /// The state at `step` of `steps`. Steps are solved in order from the last one solved;
+    /// asking for an earlier step restarts from the undeformed state.
+    pub fn solve_step(
+        &mut self,
+        body: &Body,
+        step: usize,
+        steps: usize,
+    ) -> Result<StepState, SolveError> {
+        if step < self.step || step == 0 {
+            self.u.iter_mut().for_each(|v| *v = 0.0);
+            self.previous.iter_mut().for_each(|v| *v = 0.0);
+            self.lambda = 0.0;
+            self.step = 0;
+            self.negative_pivots = 0;
+            self.force_floor = 0.0;
+            self.displacement_floor = 0.0;
+            // Step 0 (no load, no support moved) is in equilibrium undeformed.
+            self.path = vec![(0.0, self.u.clone())];
+        }
+        let mut iterations = 0;
+        let mut cuts = 0;
+        let cg_before = self.linear_iterations();
+        while self.step < step {
+            let target = self.step + 1;
+            let (i, c) = match body.newton.path {
+                PathMethod::Schedules => self.advance_schedules(body, target, steps)?,
+                PathMethod::ArcLength { length } => {
+                    self.advance_arc_length(body, target, length)?
+                }
+            };
+            iterations += i;
+            cuts += c;
+            self.step = target;
+        }
+        let mut state = self.state(body, steps);
+        state.iterations = iterations;
+        state.cuts = cuts;
+        state.linear_iterations = self.linear_iterations() - cg_before;
+        if step > 0 {
+            state.residual_history = self.residual_history.clone();
+        }
+        if !state.residual.is_finite()
+            || state
+                .displacements
+                .iter()
+                .any(|u| !u.iter().all(|c| c.is_finite()))
+            || !state.axial_forces.iter().all(|n| n.is_finite())
+        {
+            return Err(SolveError::Inaccurate {
+                body: body.name.clone(),
+                residual: state.residual,
+            });
+        }
+        Ok(state)
+    }
+
+    /// The full state at the current displacement (post-processing shared with the linear
+    /// solve).
+    fn state(&self, body: &Body, steps: usize) -> StepState {
+        let forces = self.forces_at(body, self.step as Real, steps);
+        let mut internal = vec![0.0; self.u.len()];
+        internal_forces(body, &self.u, &mut internal);
+        let members = (0..body.members.len()).map(|m| {
+            let r = member_response_at(body, &self.u, m);
+            (r.strain, r.force)
+        });
+        let mut state = post_process(body, &self.dofs, &self.u, &forces, &internal, members);
+        let mut scale = force_scale(&self.dofs, &forces, &internal).max(self.force_floor);
+        if let PathMethod::ArcLength { .. } = body.newton.path {
+            state.load_factor = Some(self.lambda);
+            scale = scale.max(norm(&full_loads(body)));
+        }
+        let out_of_balance = free_out_of_balance(&self.dofs, &forces, &internal);
+        state.residual = Convergence::relative(out_of_balance, scale);
+        state.negative_pivots = self.negative_pivots;
+        state
+    }
+
+    /// Applied force per body DOF at pseudo-time `t` (step units, fractional between steps),
+    /// N: each load's schedule interpolated linearly between steps; in arc-length mode the
+    /// reference load times the current load factor.
+    fn forces_at(&self, body: &Body, t: Real, steps: usize) -> Vec<Real> {
+        if let PathMethod::ArcLength { .. } = body.newton.path {
+            return full_loads(body).iter().map(|f| f * self.lambda).collect();
+        }
+        loads_at(body, t, steps)
+    }
+
+    fn fill_tangent(&mut self, body: &Body) {
+        fill_tangent(body, &self.assembly, &self.u, &mut self.values);
+    }
+
+    fn factorize(&mut self) -> Result<usize, TangentError> {
+        let Some(solver) = self.solver.as_mut() else {
+            return Ok(0);
+        };
+        let negative = solver.factorize(&self.values)?;
+        self.negative_pivots = negative;
+        Ok(negative)
+    }
+
+    /// Refill and refactor the tangent at the current displacement.
+    fn refactor(&mut self, body: &Body) -> Result<(), String> {
+        let t = Instant::now();
+        self.fill_tangent(body);
+        self.times.assembly += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let result = self.factorize();
+        self.times.numeric += t.elapsed().as_secs_f64();
+        result.map(|_| ()).map_err(|e| self.describe(e))
+    }
+
+    /// What a failed tangent factorization means for the user.
+    fn describe(&self, error: TangentError) -> String {
+        match error {
+            TangentError::Indefinite { dof } => {
+                let (node, dir) = self.dofs.node_and_direction(self.dofs.free[dof]);
+                format!(
+                    "the tangent stiffness is singular or indefinite at node {} ({}): the body is at or past a limit point or buckles",
+                    node + 1,
+                    direction_name(dir)
+                )
+            }
+            TangentError::Other(m) => m,
+        }
+    }
+
+    fn solve(&mut self, rhs: &mut [Real]) -> Result<(), String> {
+        let t = Instant::now();
+        let result = match self.solver.as_mut() {
+            Some(s) => s.solve_in_place(rhs),
+            None => Ok(()),
+        };
+        self.times.solve += t.elapsed().as_secs_f64();
+        result.map_err(|e| self.describe(e))
+    }
+
+    /// Internal forces and the free out-of-balance `F − f_int` at the current displacement
+    /// (timed as assembly).
+    fn out_of_balance(&mut self, body: &Body, forces: &[Real], internal: &mut [Real]) -> Vec<Real> {
+        let t = Instant::now();
+        internal_forces(body, &self.u, internal);
+        self.times.assembly += t.elapsed().as_secs_f64();
+        self.dofs
+            .free
+            .iter()
+            .map(|&dof| forces[dof] - internal[dof])
+            .collect()
+    }
+
+    /// Move the free DOFs by `s δ` with `s` = 1, 1/2, … 1/16: the first `s` that lowers the
+    /// out-of-balance norm (Armijo, 1e-4), else the best tried. Returns the length moved.
+    fn line_search(
+        &mut self,
+        body: &Body,
+        forces: &[Real],
+        delta: &[Real],
+        r0: Real,
+        internal: &mut [Real],
+    ) -> Real {
+        let base: Vec<Real> = self.dofs.free.iter().map(|&dof| self.u[dof]).collect();
+        let (s, accepted) = backtrack(r0, |s| {
+            self.move_free(&base, delta, s);
+            norm(&self.out_of_balance(body, forces, internal))
+        });
+        if !accepted {
+            self.move_free(&base, delta, s);
+        }
+        s * norm(delta)
+    }
+
+    /// Raise the floors of the relative tests to a converged state's force scale (N) and
+    /// displacement norm (m).
+    fn converged(&mut self, force_scale: Real, displacement_norm: Real) {
+        self.force_floor = self.force_floor.max(force_scale);
+        self.displacement_floor = self.displacement_floor.max(displacement_norm);
+    }
+
+    /// Free displacements `base + s δ` (both per free DOF).
+    fn move_free(&mut self, base: &[Real], delta: &[Real], s: Real) {
+        for (i, &dof) in self.dofs.free.iter().enumerate() {
+            self.u[dof] = base[i] + s * delta[i];
+        }
+    }
+}
+
+/// The size of the next increment within a step, as the fraction `2^-depth` of the step:
+/// halved after an increment fails, doubled again after two successes in a row (so a hard
+/// stretch of the path is crossed in small increments, and the rest of the step is not).
+#[derive(Clone, Copy, Debug, Default)]
+struct IncrementSize {
+    depth: usize,
+    streak: usize,
+    /// Halvings so far in this step.
+    cuts: usize,
+}
+
+impl IncrementSize {
+    fn fraction(&self) -> Real {
+        0.5f64.powi(self.depth.min(1000) as i32)
+    }
+
+    fn succeeded(&mut self) {
+        self.streak += 1;
+        if self.streak >= 2 && self.depth > 0 {
+            self.depth -= 1;
+            self.streak = 0;
+        }
+    }
+
+    /// Halve; false when that would go below `2^-max_cuts` of a step.
+    fn failed(&mut self, max_cuts: usize) -> bool {
+        self.streak = 0;
+        if self.depth >= max_cuts {
+            return false;
+        }
+        self.depth += 1;
+        self.cuts += 1;
+        true
+    }
+    /// After `failure` of an increment of step `step`: halve, or give the step's error when
+    /// the increment is already the smallest allowed.
+    fn retry(
+        &mut self,
+        body: &Body,
+        step: usize,
+        failure: IncrementFailure,
+    ) -> Result<(), SolveError> {
+        if self.failed(body.newton.max_cuts) {
+            Ok(())
+        } else {
+            Err(not_converged(body, step, self, failure))
+        }
+    }
+}
+
+/// The error for a step that could not be solved even with the smallest increment.
+fn not_converged(
+    body: &Body,
+    step: usize,
+    size: &IncrementSize,
+    failure: IncrementFailure,
+) -> SolveError {
+    SolveError::NotConverged {
+        body: body.name.clone(),
+        step,
+        depth: size.depth,
+        cuts: size.cuts,
+        reason: failure.reason,
+        history: failure.history,
+    }
+}
