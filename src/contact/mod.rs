@@ -15,6 +15,7 @@ pub use self::surface::{cut_by_z0, obstacle_surface, Surface};
 mod boundary;
 mod condensed;
 mod contact_set;
+mod coupled;
 mod coupled_system;
 mod detect;
 mod error;
