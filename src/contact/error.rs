@@ -1,6 +1,7 @@
 //! Why a scene with contact could not be solved.
 
 use crate::contact::SurfaceProblem;
+use crate::linalg::CholeskyError;
 use crate::linkage::SolveError;
 use crate::Real;
 
@@ -44,7 +45,7 @@ pub enum ContactError {
     },
     /// The sparse factorization failed for another reason.
     #[error("the sparse factorization of the bodies in contact failed: {0}")]
-    Factorization(String),
+    Factorization(CholeskyError),
     /// The arc-length method is not available with contact.
     #[error("body '{body}': [bodies.path] method = \"arc_length\" cannot be combined with contact (obstacles or several bodies): use the default load schedules")]
     ArcLength {

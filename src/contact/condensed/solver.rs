@@ -1,0 +1,608 @@
+//! The condensed Newton of the settle loop when every body is linear: on the contact candidates only, each body factored once per run.
+
+use crate::contact::condensed::{
+    CondenseFailure, CondensedBody, ContactJacobian, ContactRow, Correction, NOT_CANDIDATE,
+};
+use crate::contact::detect::widen;
+use crate::contact::settle::{largest_nodal_move, BodyPart, Problem, STABILISATION};
+use crate::contact::{ActiveContact, ContactError, ContactSet};
+use crate::linkage::body_state::norm;
+use crate::linkage::line_search::backtrack;
+use crate::linkage::{Body, Convergence, Mechanism, PhaseTimes};
+use crate::Real;
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// A linear body's condensed state within the settle loop.
+struct Condensation {
+    body: CondensedBody,
+    /// Contact forces assumed at the candidate slots, N.
+    fhat: Vec<Real>,
+    /// Rigid-motion amplitudes, m.
+    alpha: Vec<Real>,
+    /// The step's load per free DOF, N, and `K⁻¹` of it at the candidates, m.
+    load: Vec<Real>,
+    base: Vec<Real>,
+    /// Body displacements of the last full solve, m, and the amplitudes then.
+    expanded: Vec<Real>,
+    alpha_expanded: Vec<Real>,
+    /// Load plus contact forces per free DOF at the last full solve, N.
+    rhs_expanded: Vec<Real>,
+    /// The step being solved and the number of steps (the load of a body condensed again).
+    step: (usize, usize),
+    /// The last two solved steps: (step, f̂, α), oldest first (the next step starts from their
+    /// extrapolation).
+    history: Vec<(usize, Vec<Real>, Vec<Real>)>,
+    /// Whether the bodies' displacements are those of the last full solve (no placement since).
+    fresh: bool,
+}
+
+impl Condensation {
+    fn new(body: CondensedBody, dofs: usize) -> Self {
+        let r = body.modes.len();
+        Condensation {
+            fhat: vec![0.0; body.len()],
+            alpha: vec![0.0; r],
+            load: Vec::new(),
+            base: vec![0.0; body.len()],
+            expanded: vec![0.0; dofs],
+            alpha_expanded: vec![0.0; r],
+            rhs_expanded: vec![0.0; body.slot.len()],
+            history: Vec::new(),
+            step: (0, 1),
+            fresh: false,
+            body,
+        }
+    }
+}
+
+/// The residuals of the condensed problem at one placement.
+struct Residual {
+    /// Per body, contact force found minus assumed at the candidates, N.
+    phi1: Vec<Vec<Real>>,
+    /// Per body, the out-of-balance along its rigid motions, N.
+    phi2: Vec<Vec<Real>>,
+    /// Their norm, N.
+    norm: Real,
+    /// The force scale (applied and contact forces, at least the force floor), N.
+    scale: Real,
+    /// The contact rows at the placement.
+    rows: Vec<ContactRow>,
+}
+
+/// The Newton of the contact problem on the bodies' contact candidates, every body linear and
+/// factored once per run (see [`CondensedBody`] and [`ContactJacobian`]).
+pub(crate) struct CondensedSolver {
+    bodies: Vec<Condensation>,
+    /// The factored Jacobian of the condensed contact problem and the set it was made for.
+    jacobian: Option<(ContactSet, ContactJacobian)>,
+}
+
+impl CondensedSolver {
+    /// Condense every body on the nodes of `marks`; `None` if one cannot be (the coupled solve
+    /// then), with the mechanism found if that was why.
+    pub(crate) fn build(
+        bodies: &[Body],
+        parts: &[BodyPart],
+        marks: Vec<Vec<bool>>,
+        times: &mut PhaseTimes,
+    ) -> (Option<Self>, Option<Box<Mechanism>>) {
+        let mut built = Vec::with_capacity(bodies.len());
+        for ((body, part), mark) in bodies.iter().zip(parts).zip(marks) {
+            match CondensedBody::new(body, &part.dofs, &part.assembly, mark) {
+                Ok(c) => {
+                    add_seconds(times, &c);
+                    built.push(Condensation::new(c, body.dof_count()));
+                }
+                Err(CondenseFailure::Mechanism(m)) => return (None, Some(m)),
+                Err(CondenseFailure::Other) => return (None, None),
+            }
+        }
+        let solver = CondensedSolver {
+            bodies: built,
+            jacobian: None,
+        };
+        (Some(solver), None)
+    }
+
+    /// Contact candidates of `body` (nodes).
+    pub(crate) fn candidates(&self, body: usize) -> Option<usize> {
+        let c = self.bodies.get(body)?;
+        Some(c.body.nodes.iter().filter(|&&m| m).count())
+    }
+
+    /// Start `step` of `steps`: each body's load and base displacement (`restart`: from rest).
+    pub(crate) fn start_step(&mut self, step: usize, steps: usize, restart: bool) {
+        for c in self.bodies.iter_mut() {
+            if restart {
+                c.fhat.iter_mut().for_each(|v| *v = 0.0);
+                c.alpha.iter_mut().for_each(|v| *v = 0.0);
+                c.alpha_expanded.iter_mut().for_each(|v| *v = 0.0);
+                c.expanded.iter_mut().for_each(|v| *v = 0.0);
+                c.rhs_expanded.iter_mut().for_each(|v| *v = 0.0);
+                c.history.clear();
+            }
+            // Start from the straight line through the last two solved steps (exact for loads
+            // that grow in proportion while the contacts stay): Newton then only corrects.
+            if let [(s0, f0, a0), (s1, f1, a1)] = &c.history[..] {
+                if *s1 + 1 == step && *s0 + 1 == *s1 && f1.len() == c.fhat.len() {
+                    for (v, (x1, x0)) in c.fhat.iter_mut().zip(f1.iter().zip(f0)) {
+                        *v = 2.0 * x1 - x0;
+                    }
+                    for (v, (x1, x0)) in c.alpha.iter_mut().zip(a1.iter().zip(a0)) {
+                        *v = 2.0 * x1 - x0;
+                    }
+                }
+            }
+            let (load, base) = c.body.step_load(step, steps);
+            c.load = load;
+            c.base = base;
+            c.fresh = false;
+            c.step = (step, steps);
+        }
+    }
+
+    /// Remember the solved state of `step` for the next step's start.
+    pub(crate) fn solved(&mut self, step: usize) {
+        for c in self.bodies.iter_mut() {
+            if c.history.len() == 2 {
+                c.history.remove(0);
+            }
+            c.history.push((step, c.fhat.clone(), c.alpha.clone()));
+        }
+    }
+
+    /// Write the condensed state into the bodies' displacements: exact at the candidates,
+    /// the last full solve plus the rigid motion since elsewhere.
+    fn place(&mut self, parts: &mut [BodyPart]) {
+        for (part, c) in parts.iter_mut().zip(self.bodies.iter_mut()) {
+            c.fresh = false;
+            let moved: Vec<Real> = c
+                .alpha
+                .iter()
+                .zip(&c.alpha_expanded)
+                .map(|(a, b)| a - b)
+                .collect();
+            let rigid = moved.iter().any(|&a| a != 0.0);
+            for (i, &dof) in part.dofs.free.iter().enumerate() {
+                if c.body.slot[i] == NOT_CANDIDATE {
+                    let mut u = c.expanded[dof];
+                    if rigid {
+                        u += c
+                            .body
+                            .modes
+                            .iter()
+                            .zip(&moved)
+                            .map(|(r, a)| a * r[i])
+                            .sum::<Real>();
+                    }
+                    part.u[dof] = u;
+                }
+            }
+            let mut u = c.body.comply(&c.fhat);
+            for (s, v) in u.iter_mut().enumerate() {
+                *v += c.base[s]
+                    + c.body
+                        .modes_c
+                        .iter()
+                        .zip(&c.alpha)
+                        .map(|(r, a)| a * r[s])
+                        .sum::<Real>();
+            }
+            for (s, &i) in c.body.cand.iter().enumerate() {
+                part.u[part.dofs.free[i]] = u[s];
+            }
+        }
+    }
+
+    /// The full displacement of every body (one solve each), kept for the next placements.
+    /// The dense compliance places the candidates to its own round-off (which grows with the
+    /// condition of the body's stiffness); the difference to the solve is folded into the
+    /// base displacement so that later placements reproduce the solve exactly. Returns that
+    /// difference as a force, the largest stiffness times the largest difference, relative to
+    /// the largest load or contact force norm of a body (0 when nothing changed). The
+    /// candidates keep their placed values, so the contact forces are Newton's; the difference
+    /// only unbalances the members next to them.
+    pub(crate) fn expand(&mut self, parts: &mut [BodyPart], times: &mut PhaseTimes) -> Real {
+        let t = Instant::now();
+        if self.bodies.iter().all(|c| c.fresh) {
+            return 0.0;
+        }
+        // One solve per body, the bodies side by side.
+        let each: Vec<(Real, Real)> = parts
+            .par_iter_mut()
+            .zip(self.bodies.par_iter_mut())
+            .map(|(part, c)| {
+                let mut differs: Real = 0.0;
+                c.fresh = true;
+                let mut rhs = c.load.clone();
+                for (s, &i) in c.body.cand.iter().enumerate() {
+                    rhs[i] += c.fhat[s];
+                }
+                let change: Vec<Real> = rhs
+                    .iter()
+                    .zip(&c.rhs_expanded)
+                    .map(|(a, b)| a - b)
+                    .collect();
+                let dalpha: Vec<Real> = c
+                    .alpha
+                    .iter()
+                    .zip(&c.alpha_expanded)
+                    .map(|(a, b)| a - b)
+                    .collect();
+                let du = c.body.expand(&change, &dalpha);
+                let u: Vec<Real> = part
+                    .dofs
+                    .free
+                    .iter()
+                    .zip(&du)
+                    .map(|(&dof, d)| c.expanded[dof] + d)
+                    .collect();
+                c.rhs_expanded = rhs;
+                // The candidates keep their placed values: the contact forces were balanced
+                // there, and a penalty turns a last-bit difference of a position into a force.
+                let largest = norm(&c.load).max(norm(&c.fhat));
+                for (s, &i) in c.body.cand.iter().enumerate() {
+                    let placed = part.u[part.dofs.free[i]];
+                    differs = differs.max(c.body.stiffness * (u[i] - placed).abs());
+                    c.base[s] += u[i] - placed;
+                }
+                for (i, &dof) in part.dofs.free.iter().enumerate() {
+                    if c.body.slot[i] == NOT_CANDIDATE {
+                        part.u[dof] = u[i];
+                    }
+                }
+                // The next solve adds to the solved displacement (placed values aside).
+                c.expanded.clone_from(&part.u);
+                for &i in &c.body.cand {
+                    c.expanded[part.dofs.free[i]] = u[i];
+                }
+                c.alpha_expanded.clone_from(&c.alpha);
+                (differs, largest)
+            })
+            .collect();
+        let differs = each.iter().map(|e| e.0).fold(0.0, Real::max);
+        let largest = each.iter().map(|e| e.1).fold(0.0, Real::max);
+        times.solve += t.elapsed().as_secs_f64();
+        if largest > 0.0 {
+            differs / largest
+        } else {
+            0.0
+        }
+    }
+
+    /// Residuals of the condensed problem at the current placement (see [`Residual`]), the
+    /// contacts evaluated once there. `Err` with the (body, node) pairs a contact reaches
+    /// outside the candidates.
+    fn residual(
+        &mut self,
+        p: &Problem,
+        parts: &mut [BodyPart],
+        normals: &mut HashMap<ActiveContact, Vector3<Real>>,
+    ) -> Result<Residual, Vec<(usize, usize)>> {
+        self.place(parts);
+        let evaluated = p.evaluate(normals, parts);
+        let fc = &evaluated.forces;
+        let mut missing = Vec::new();
+        let mut rows = Vec::with_capacity(evaluated.list.len());
+        for e in &evaluated.list {
+            let Some(n) = e.normal else { continue };
+            let mut entries = Vec::with_capacity(12);
+            for &(b, node, w) in &e.nodes {
+                let dofs = &parts[b].dofs;
+                for k in 0..dofs.dofs_per_node {
+                    if let Some(i) = dofs.free_index(node, k) {
+                        match self.bodies[b].body.slot[i] {
+                            NOT_CANDIDATE => missing.push((b, node)),
+                            s => entries.push((b, s, w * n[k])),
+                        }
+                    }
+                }
+            }
+            if !entries.is_empty() && e.penalty.stiffness > 0.0 {
+                rows.push(ContactRow {
+                    penalty: e.penalty.stiffness,
+                    entries,
+                });
+            }
+        }
+        if !missing.is_empty() {
+            missing.sort_unstable();
+            missing.dedup();
+            return Err(missing);
+        }
+        let (mut sum, mut applied, mut contact) = (0.0, 0.0, 0.0);
+        let mut phi1 = Vec::with_capacity(self.bodies.len());
+        let mut phi2 = Vec::with_capacity(self.bodies.len());
+        for (b, c) in self.bodies.iter().enumerate() {
+            let free = &parts[b].dofs.free;
+            let p1: Vec<Real> = c
+                .body
+                .cand
+                .iter()
+                .zip(&c.fhat)
+                .map(|(&i, f)| fc[b][free[i]] - f)
+                .collect();
+            let p2: Vec<Real> = c
+                .body
+                .modes
+                .iter()
+                .zip(&c.body.modes_c)
+                .map(|(r, rc)| {
+                    r.iter().zip(&c.load).map(|(a, l)| a * l).sum::<Real>()
+                        + rc.iter().zip(&c.fhat).map(|(a, f)| a * f).sum::<Real>()
+                })
+                .collect();
+            sum += p1.iter().chain(&p2).map(|v| v * v).sum::<Real>();
+            applied += p.forces[b].iter().map(|f| f * f).sum::<Real>();
+            contact += fc[b].iter().map(|f| f * f).sum::<Real>();
+            phi1.push(p1);
+            phi2.push(p2);
+        }
+        let scale = applied.sqrt().max(contact.sqrt()).max(p.force_floor);
+        Ok(Residual {
+            phi1,
+            phi2,
+            norm: sum.sqrt(),
+            scale,
+            rows,
+        })
+    }
+
+    /// Set the condensed state to `base` plus `s` times a correction.
+    fn apply(&mut self, base: &[(Vec<Real>, Vec<Real>)], corr: &Correction, s: Real) {
+        for ((c, (f0, a0)), (df, da)) in self
+            .bodies
+            .iter_mut()
+            .zip(base)
+            .zip(corr.fhat.iter().zip(&corr.alpha))
+        {
+            for (v, (x, d)) in c.fhat.iter_mut().zip(f0.iter().zip(df)) {
+                *v = x + s * d;
+            }
+            for (v, (x, d)) in c.alpha.iter_mut().zip(a0.iter().zip(da)) {
+                *v = x + s * d;
+            }
+        }
+    }
+
+    /// The displacements at every body's candidates as placed, m.
+    fn candidate_displacements(&self, parts: &[BodyPart]) -> Vec<Vec<Real>> {
+        self.bodies
+            .iter()
+            .zip(parts)
+            .map(|(c, part)| {
+                c.body
+                    .cand
+                    .iter()
+                    .map(|&i| part.u[part.dofs.free[i]])
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The largest nodal displacement at the candidates, m.
+    fn candidate_norm(&self, parts: &[BodyPart]) -> Real {
+        let mut largest: Real = 0.0;
+        for (c, part) in self.bodies.iter().zip(parts) {
+            for &i in &c.body.cand {
+                largest = largest.max(part.u[part.dofs.free[i]].abs());
+            }
+        }
+        largest
+    }
+
+    /// The largest nodal move of a correction at the candidates and, rigidly, anywhere, m.
+    fn largest_move(&self, parts: &[BodyPart], corr: &Correction) -> Real {
+        let mut largest: Real = 0.0;
+        for ((c, part), (df, da)) in self
+            .bodies
+            .iter()
+            .zip(parts)
+            .zip(corr.fhat.iter().zip(&corr.alpha))
+        {
+            let flexible = c.body.comply(df);
+            let moved = |i: usize| {
+                let mut m: Real = c.body.modes.iter().zip(da).map(|(r, a)| a * r[i]).sum();
+                if c.body.slot[i] != NOT_CANDIDATE {
+                    m += flexible[c.body.slot[i]];
+                }
+                m
+            };
+            largest = largest.max(largest_nodal_move(part, moved));
+        }
+        largest
+    }
+
+    /// Add the nodes in `missing` (and two rings of neighbours) to their bodies' candidates and
+    /// condense those bodies again. `false` if one cannot be condensed.
+    fn grow(
+        &mut self,
+        bodies: &[Body],
+        parts: &[BodyPart],
+        missing: &[(usize, usize)],
+        times: &mut PhaseTimes,
+    ) -> bool {
+        for (b, body) in bodies.iter().enumerate() {
+            if !missing.iter().any(|&(mb, _)| mb == b) {
+                continue;
+            }
+            let mut mark = self.bodies[b].body.nodes.clone();
+            for &(_, node) in missing.iter().filter(|&&(mb, _)| mb == b) {
+                mark[node] = true;
+            }
+            widen(body, &mut mark, 2);
+            let part = &parts[b];
+            let Ok(grown) = CondensedBody::new(body, &part.dofs, &part.assembly, mark) else {
+                return false;
+            };
+            add_seconds(times, &grown);
+            let c = &mut self.bodies[b];
+            let mut fhat = vec![0.0; grown.len()];
+            for (s, &i) in c.body.cand.iter().enumerate() {
+                fhat[grown.slot[i]] = c.fhat[s];
+            }
+            c.fhat = fhat;
+            c.history.clear();
+            c.fresh = false;
+            c.body = grown;
+            let (load, base) = c.body.step_load(c.step.0, c.step.1);
+            c.load = load;
+            c.base = base;
+        }
+        true
+    }
+
+    /// Newton on the candidates with the contact set of `p` fixed: `Some` with the iterations
+    /// and whether it converged (`false` after one stabilised move, as the coupled Newton);
+    /// `None` when a body cannot be condensed on the nodes the contacts reach (the caller then
+    /// solves coupled from the displacements left in `parts`). The factored Jacobian of a set
+    /// is kept for the next call with the same set (the next step, or a refinement after the
+    /// full solve).
+    pub(crate) fn newton(
+        &mut self,
+        p: &Problem,
+        parts: &mut [BodyPart],
+        normals: &mut HashMap<ActiveContact, Vector3<Real>>,
+        times: &mut PhaseTimes,
+    ) -> Result<Option<(usize, bool)>, ContactError> {
+        let mut jacobian = self
+            .jacobian
+            .take()
+            .filter(|(s, _)| s == p.set)
+            .map(|(_, j)| j);
+        let result = self.newton_with(p, parts, normals, times, &mut jacobian);
+        self.jacobian = jacobian.map(|j| (p.set.clone(), j));
+        result
+    }
+
+    fn newton_with(
+        &mut self,
+        p: &Problem,
+        parts: &mut [BodyPart],
+        normals: &mut HashMap<ActiveContact, Vector3<Real>>,
+        times: &mut PhaseTimes,
+        jacobian: &mut Option<ContactJacobian>,
+    ) -> Result<Option<(usize, bool)>, ContactError> {
+        let stabilisation = STABILISATION
+            * parts
+                .iter()
+                .map(|p| p.penalty.stiffness)
+                .fold(0.0, Real::max);
+        let mut monitor = Convergence::new(p.tolerance);
+        let mut iterations = 0;
+        let mut last_step = Real::INFINITY;
+        let fresh = self.bodies.iter().all(|c| c.fresh);
+        // The residual of the state the line search accepted (evaluated there already).
+        let mut pending = None;
+        loop {
+            let t = Instant::now();
+            let evaluated = match pending.take() {
+                Some(e) => Ok(e),
+                None => self.residual(p, parts, normals),
+            };
+            times.assembly += t.elapsed().as_secs_f64();
+            let residual = match evaluated {
+                Ok(e) => e,
+                Err(missing) => {
+                    if !missing.is_empty() && self.grow(p.bodies, parts, &missing, times) {
+                        *jacobian = None;
+                        continue;
+                    }
+                    // A body could not be condensed again: the coupled solve from here.
+                    return Ok(None);
+                }
+            };
+            let size = self.candidate_norm(parts);
+            if p.converged(
+                &mut monitor,
+                residual.norm,
+                residual.scale,
+                iterations,
+                last_step,
+                size,
+            )? {
+                if iterations == 0 && fresh {
+                    // Nothing moved: the displacements are still those of the last solve.
+                    self.bodies.iter_mut().for_each(|c| c.fresh = true);
+                }
+                return Ok(Some((iterations, true)));
+            }
+            let t = Instant::now();
+            let views: Vec<&CondensedBody> = self.bodies.iter().map(|c| &c.body).collect();
+            // Modified Newton: keep the factored Jacobian while it converges fast (the contacts'
+            // normals and weights move little within one contact set).
+            // Near the round-off floor the Jacobian's age no longer matters.
+            // A Jacobian carried over from an earlier call is tried once.
+            let near_floor = monitor.last().is_some_and(|r| r < 1e3 * p.tolerance);
+            let reuse = jacobian.as_ref().is_some_and(|j: &ContactJacobian| {
+                j.rows().len() == residual.rows.len()
+                    && (monitor.len() < 2 || monitor.converging_fast() || near_floor)
+            });
+            if !reuse {
+                *jacobian = ContactJacobian::new(&views, residual.rows, stabilisation).ok();
+            }
+            let Some(jac) = jacobian.as_ref() else {
+                return Ok(self.fall_back(parts, times));
+            };
+            let corr = jac.correction(&views, &residual.phi1, &residual.phi2);
+            let base: Vec<(Vec<Real>, Vec<Real>)> = self
+                .bodies
+                .iter()
+                .map(|c| (c.fhat.clone(), c.alpha.clone()))
+                .collect();
+            times.solve += t.elapsed().as_secs_f64();
+            iterations += 1;
+            if corr.stabilised {
+                if let Some(s) = p.capped(self.largest_move(parts, &corr)) {
+                    self.apply(&base, &corr, s);
+                    self.place(parts);
+                    return Ok(Some((iterations, false)));
+                }
+            }
+            let before = self.candidate_displacements(parts);
+            // The residual of the accepted trial is the next iteration's: kept, not recomputed.
+            let mut last = None;
+            let (s, accepted) = backtrack(residual.norm, |s| {
+                self.apply(&base, &corr, s);
+                last = self.residual(p, parts, normals).ok();
+                last.as_ref().map_or(Real::INFINITY, |e| e.norm)
+            });
+            if accepted {
+                pending = last;
+            } else {
+                self.apply(&base, &corr, s);
+                self.place(parts);
+            }
+            last_step = before
+                .iter()
+                .zip(self.candidate_displacements(parts))
+                .flat_map(|(a, b)| {
+                    a.iter()
+                        .zip(b)
+                        .map(|(x, y)| (x - y).abs())
+                        .collect::<Vec<_>>()
+                })
+                .fold(0.0, Real::max);
+        }
+    }
+
+    /// Leave the condensed path: the full displacements into `parts` (`None`: solve coupled).
+    fn fall_back(
+        &mut self,
+        parts: &mut [BodyPart],
+        times: &mut PhaseTimes,
+    ) -> Option<(usize, bool)> {
+        self.expand(parts, times);
+        None
+    }
+}
+
+/// Add a condensation's analysis, factorization and solve times to `times`.
+fn add_seconds(times: &mut PhaseTimes, c: &CondensedBody) {
+    times.symbolic += c.seconds[0];
+    times.numeric += c.seconds[1];
+    times.solve += c.seconds[2];
+}

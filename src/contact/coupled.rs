@@ -1,0 +1,299 @@
+//! The coupled Newton of all bodies in contact: one sparse system of members and penalties, refactored per iteration (or kept while a linear model converges fast).
+
+use crate::contact::coupled_system::CoupledSystem;
+use crate::contact::evaluate::{Evaluated, Evaluation};
+use crate::contact::settle::{largest_nodal_move, BodyPart, Problem, STABILISATION};
+use crate::contact::{ActiveContact, ContactError, ContactSet};
+use crate::linalg::CholeskyError;
+use crate::linkage::body_state::{fill_tangent, internal_force_vector, norm};
+use crate::linkage::line_search::backtrack;
+use crate::linkage::{Convergence, PhaseTimes, StiffnessAssembly};
+use crate::Real;
+use nalgebra::Vector3;
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// The Newton of all bodies as one coupled sparse system (members plus penalties).
+pub(crate) struct CoupledSolver {
+    system: CoupledSystem,
+    /// First global node of each body.
+    node_offsets: Vec<usize>,
+    /// Entries between bodies added to the coupled pattern so far (global free DOFs, r ≥ c).
+    coupling: Vec<(usize, usize)>,
+    /// The contact set the current factorization was made with (not stabilised).
+    factored: Option<ContactSet>,
+    /// The body whose tangent was singular last (for messages).
+    pub(crate) unheld: usize,
+}
+
+impl CoupledSolver {
+    /// The coupled pattern of `parts`, analyzed (an empty system when `analyze` is false: the
+    /// condensed path builds it only if it falls back).
+    pub(crate) fn new(
+        parts: &[BodyPart],
+        node_offsets: Vec<usize>,
+        analyze: bool,
+    ) -> Result<Self, ContactError> {
+        let system = if analyze {
+            let assemblies: Vec<&StiffnessAssembly> = parts.iter().map(|p| &p.assembly).collect();
+            CoupledSystem::new(&assemblies, &node_offsets, &[])
+        } else {
+            CoupledSystem::new(&[], &[], &[])
+        }
+        .map_err(ContactError::Factorization)?;
+        Ok(CoupledSolver {
+            system,
+            node_offsets,
+            coupling: Vec::new(),
+            factored: None,
+            unheld: 0,
+        })
+    }
+
+    /// The coupled pattern of all bodies with the entries between bodies so far, analyzed.
+    pub(crate) fn rebuild(&mut self, parts: &[BodyPart]) -> Result<(), ContactError> {
+        let assemblies: Vec<&StiffnessAssembly> = parts.iter().map(|p| &p.assembly).collect();
+        self.system = CoupledSystem::new(&assemblies, &self.node_offsets, &self.coupling)
+            .map_err(ContactError::Factorization)?;
+        Ok(())
+    }
+
+    /// The out-of-balance force `F + f_c − f_int` at the free DOFs of all bodies (global
+    /// order), N, for the contacts `evaluated` at the current displacements; and the force
+    /// scale it is measured against: the largest of the applied, reaction and contact force
+    /// norms, at least the force floor.
+    fn out_of_balance(
+        &self,
+        p: &Problem,
+        parts: &[BodyPart],
+        evaluated: &Evaluation,
+    ) -> (Vec<Real>, Real) {
+        let mut r = vec![0.0; self.system.n];
+        let (mut applied, mut reacted, mut contact) = (0.0, 0.0, 0.0);
+        for ((b, body), fc) in p.bodies.iter().enumerate().zip(&evaluated.forces) {
+            let part = &parts[b];
+            let internal = internal_force_vector(body, &part.u);
+            let offset = self.system.offsets[b];
+            for (i, &dof) in part.dofs.free.iter().enumerate() {
+                r[offset + i] = p.forces[b][dof] + fc[dof] - internal[dof];
+            }
+            for &dof in &part.dofs.supported {
+                reacted += (internal[dof] - p.forces[b][dof] - fc[dof]).powi(2);
+            }
+            applied += p.forces[b].iter().map(|f| f * f).sum::<Real>();
+            contact += fc.iter().map(|f| f * f).sum::<Real>();
+        }
+        let scale = applied.sqrt().max(reacted.sqrt()).max(contact.sqrt());
+        (r, scale.max(p.force_floor))
+    }
+
+    /// Newton with the contact set of `p` fixed (see [`crate::contact::ContactSolver`]).
+    pub(crate) fn newton(
+        &mut self,
+        p: &Problem,
+        parts: &mut [BodyPart],
+        normals: &mut HashMap<ActiveContact, Vector3<Real>>,
+        times: &mut PhaseTimes,
+    ) -> Result<(usize, bool), ContactError> {
+        let mut monitor = Convergence::new(p.tolerance);
+        let mut iterations = 0;
+        let mut last_step = Real::INFINITY;
+        let linear = p.bodies.iter().all(|b| !b.is_nonlinear());
+        // The contacts and residual of the state the line search accepted (evaluated there).
+        let mut pending = None;
+        loop {
+            let t = Instant::now();
+            let (evaluated, r, scale) = match pending.take() {
+                Some(e) => e,
+                None => {
+                    let evaluated = p.evaluate(normals, parts);
+                    let (r, scale) = self.out_of_balance(p, parts, &evaluated);
+                    (evaluated, r, scale)
+                }
+            };
+            times.assembly += t.elapsed().as_secs_f64();
+            let rnorm = norm(&r);
+            let u_norm = parts
+                .iter()
+                .map(|p| norm(&p.u).powi(2))
+                .sum::<Real>()
+                .sqrt();
+            if p.converged(&mut monitor, rnorm, scale, iterations, last_step, u_norm)? {
+                return Ok((iterations, true));
+            }
+            // Linear bodies with the same contacts keep their tangent but for the small turn of
+            // the contact normals: reuse the factor (a modified Newton step) while it converges.
+            let reuse = linear
+                && self.factored.as_ref() == Some(p.set)
+                && iterations > 0
+                && monitor.converging_fast();
+            let stabilised = if reuse {
+                false
+            } else {
+                let stabilised = self.factorize_tangent(p, parts, &evaluated.list, times)?;
+                self.factored = (!stabilised).then(|| p.set.clone());
+                stabilised
+            };
+            let t = Instant::now();
+            let mut delta = r;
+            self.system.solve_in_place(&mut delta);
+            times.solve += t.elapsed().as_secs_f64();
+            iterations += 1;
+            if stabilised {
+                // A body flying toward its contacts: move it at most the move cap, then look
+                // for contacts again. A smaller correction (the singular direction is not
+                // loaded, as the common sideways motion of two bodies pressed together) is a
+                // Newton step.
+                let largest = self.largest_move(parts, &delta);
+                if let Some(s) = p.capped(largest) {
+                    let base: Vec<Vec<Real>> = parts.iter().map(|p| p.u.clone()).collect();
+                    self.move_free(parts, &base, &delta, s);
+                    return Ok((iterations, false));
+                }
+            }
+            // Move the free DOFs by `s δ` (Armijo backtracking on the out-of-balance norm).
+            let base: Vec<Vec<Real>> = parts.iter().map(|p| p.u.clone()).collect();
+            let mut last = None;
+            let (s, accepted) = backtrack(rnorm, |s| {
+                self.move_free(parts, &base, &delta, s);
+                let evaluated = p.evaluate(normals, parts);
+                let (r, scale) = self.out_of_balance(p, parts, &evaluated);
+                let rnorm = norm(&r);
+                last = Some((evaluated, r, scale));
+                rnorm
+            });
+            if accepted {
+                pending = last;
+            } else {
+                self.move_free(parts, &base, &delta, s);
+            }
+            last_step = s * norm(&delta);
+        }
+    }
+
+    /// Fill the coupled tangent (members plus the penalties of the contacts `evaluated`) and
+    /// factor it. When it is singular (a body not held by its supports and the contacts),
+    /// factor it again with `STABILISATION` times its largest diagonal entry added to the
+    /// diagonal and return true.
+    fn factorize_tangent(
+        &mut self,
+        p: &Problem,
+        parts: &mut [BodyPart],
+        evaluated: &[Evaluated],
+        times: &mut PhaseTimes,
+    ) -> Result<bool, ContactError> {
+        let t = Instant::now();
+        self.couple(parts, evaluated, times)?;
+        for (part, body) in parts.iter_mut().zip(p.bodies) {
+            fill_tangent(body, &part.assembly, &part.u, &mut part.local);
+        }
+        let locals: Vec<Vec<Real>> = parts
+            .iter_mut()
+            .map(|p| std::mem::take(&mut p.local))
+            .collect();
+        self.system.fill(&locals);
+        for (part, local) in parts.iter_mut().zip(locals) {
+            part.local = local;
+        }
+        for e in evaluated {
+            let Some(n) = e.normal else { continue };
+            let k = e.penalty.stiffness(&n);
+            for &(b1, node1, w1) in &e.nodes {
+                for &(b2, node2, w2) in &e.nodes {
+                    let (p1, p2) = (&parts[b1], &parts[b2]);
+                    let d = p1.dofs.dofs_per_node.min(p2.dofs.dofs_per_node);
+                    for p in 0..d {
+                        for q in 0..d {
+                            if let (Some(i), Some(j)) =
+                                (p1.dofs.free_index(node1, p), p2.dofs.free_index(node2, q))
+                            {
+                                let (r, c) =
+                                    (self.system.offsets[b1] + i, self.system.offsets[b2] + j);
+                                self.system.add(r, c, w1 * w2 * k[(p, q)]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        times.assembly += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let mut result = self.system.factorize();
+        let mut stabilised = false;
+        if let Err(CholeskyError::NonPositivePivot { dof })
+        | Err(CholeskyError::NearlySingular { dof, .. }) = result
+        {
+            let (b, _) = self.system.locate(dof);
+            self.unheld = b;
+            self.system.stabilise(STABILISATION);
+            stabilised = true;
+            result = self.system.factorize();
+        }
+        times.numeric += t.elapsed().as_secs_f64();
+        result.map_err(ContactError::Factorization)?;
+        Ok(stabilised)
+    }
+
+    /// Make the coupled pattern hold the entries between the nodes of every contact
+    /// `evaluated` (new contacts between bodies add entries: the pattern is rebuilt and
+    /// analyzed again, keeping every entry added before so that a contact coming back costs
+    /// nothing).
+    fn couple(
+        &mut self,
+        parts: &[BodyPart],
+        evaluated: &[Evaluated],
+        times: &mut PhaseTimes,
+    ) -> Result<(), ContactError> {
+        let mut missing = Vec::new();
+        for e in evaluated.iter().filter(|e| e.nodes.len() > 1) {
+            for &(b1, n1, _) in &e.nodes {
+                for &(b2, n2, _) in &e.nodes {
+                    let (p1, p2) = (&parts[b1], &parts[b2]);
+                    for p in 0..p1.dofs.dofs_per_node {
+                        for q in 0..p2.dofs.dofs_per_node {
+                            if let (Some(i), Some(j)) =
+                                (p1.dofs.free_index(n1, p), p2.dofs.free_index(n2, q))
+                            {
+                                let (r, c) =
+                                    (self.system.offsets[b1] + i, self.system.offsets[b2] + j);
+                                if !self.system.contains(r, c) {
+                                    missing.push((r.max(c), r.min(c)));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if missing.is_empty() {
+            return Ok(());
+        }
+        let t = Instant::now();
+        self.coupling.extend(missing);
+        self.coupling.sort_unstable();
+        self.coupling.dedup();
+        self.rebuild(parts)?;
+        times.symbolic += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// The largest nodal length of a correction `delta` (global free DOFs), m.
+    fn largest_move(&self, parts: &[BodyPart], delta: &[Real]) -> Real {
+        let mut largest: Real = 0.0;
+        for (b, part) in parts.iter().enumerate() {
+            let offset = self.system.offsets[b];
+            largest = largest.max(largest_nodal_move(part, |i| delta[offset + i]));
+        }
+        largest
+    }
+
+    /// Set the free DOFs to `base + s δ` (`delta` over global free DOFs, m).
+    fn move_free(&self, parts: &mut [BodyPart], base: &[Vec<Real>], delta: &[Real], s: Real) {
+        for (b, part) in parts.iter_mut().enumerate() {
+            let offset = self.system.offsets[b];
+            for (i, &dof) in part.dofs.free.iter().enumerate() {
+                part.u[dof] = base[b][dof] + s * delta[offset + i];
+            }
+        }
+    }
+}

@@ -1,0 +1,470 @@
+//! Finding contacts: contact candidates, open-shell sides, and the query of every node against the obstacles and the other bodies.
+
+use crate::contact::boundary::{inside_polygon, segment_projection, Surface};
+use crate::contact::patch_surface::PatchSurface;
+use crate::contact::settle::{position, BodyPart};
+use crate::contact::{
+    penetration_tolerance, ActiveContact, ContactError, ContactSet, Obstacle, Obstacles,
+    SurfaceProblem, Target,
+};
+use crate::linkage::Body;
+use crate::Real;
+use nalgebra::Vector3;
+use std::collections::HashMap;
+
+/// A node counts as inside a surface when it is deeper than this fraction of the penetration
+/// tolerance (1e-9 of 1% of a member: round-off does not make contacts).
+pub const MIN_DEPTH: Real = 1e-9;
+
+/// How far (in barycentric weight, a fraction of the patch) a node may lie beyond the patch it
+/// pressed on and keep it (see [`Geometry::keep_patches`]).
+pub const KEEP_PATCH: Real = 0.05;
+
+/// A node on the far side of an open shell from where it started the step is in contact when
+/// it is within this many of the shell's mean member lengths of the shell (farther, it went
+/// round the shell or the nearest patch changed, and it is not held).
+pub const SHELL_REACH_MEMBERS: Real = 3.0;
+
+/// Candidates lie within this many mean member lengths of another body's bounding box or of
+/// an obstacle (anywhere along its travel).
+const MARGIN_MEMBERS: Real = 2.0;
+
+/// A deformed boundary loop and its bounding box `[x_min, y_min, x_max, y_max]`, m.
+type Polygon = (Vec<Vector3<Real>>, [Real; 4]);
+
+/// What contacts are found against: the bodies' surfaces, the sides of open shells, and the
+/// obstacles.
+pub(crate) struct Geometry {
+    /// Contact surface of each body (2D: its outer boundary), `None` if it has none.
+    pub(crate) surfaces: Vec<Option<Surface>>,
+    /// Contact surface of each 3D body: its patches, facing out (or an open shell).
+    pub(crate) patch_surfaces: Vec<Option<PatchSurface>>,
+    /// Per open shell (empty for other bodies), per body, per node: the side of the shell the
+    /// node started the step on (+1 in front of its patches, −1 behind, 0 not known).
+    pub(crate) sides: Vec<Vec<Vec<i8>>>,
+    /// Per body, how far behind it as an open shell a node may be and be held, m.
+    pub(crate) shell_reach: Vec<Real>,
+    /// The rigid obstacles, held in rapier.
+    pub(crate) obstacles: Obstacles,
+}
+
+impl Geometry {
+    /// The surfaces of `bodies` (an open shell is a two-sided target: see
+    /// [`Geometry::record_sides`]) and the colliders of `obstacles`.
+    pub(crate) fn new(bodies: &[Body], obstacles: &[Obstacle]) -> Result<Self, ContactError> {
+        let surfaces: Vec<Option<Surface>> = bodies.iter().map(Surface::of).collect();
+        let mut patch_surfaces = Vec::with_capacity(bodies.len());
+        for body in bodies {
+            patch_surfaces.push(match PatchSurface::of(body) {
+                Ok(surface) => surface,
+                Err(SurfaceProblem::NotClosed(_)) => PatchSurface::open_shell(body),
+                Err(problem) => {
+                    return Err(ContactError::Surface {
+                        body: body.name.clone(),
+                        problem,
+                    })
+                }
+            });
+        }
+        let obstacles = Obstacles::new(obstacles).map_err(ContactError::Obstacle)?;
+        let sides = patch_surfaces
+            .iter()
+            .map(|s| match s {
+                Some(s) if s.is_open() => bodies.iter().map(|b| vec![0; b.nodes.len()]).collect(),
+                _ => Vec::new(),
+            })
+            .collect();
+        let shell_reach = bodies
+            .iter()
+            .map(|b| SHELL_REACH_MEMBERS * 100.0 * penetration_tolerance(b))
+            .collect();
+        Ok(Geometry {
+            surfaces,
+            patch_surfaces,
+            sides,
+            shell_reach,
+            obstacles,
+        })
+    }
+
+    /// The name of what a contact touches.
+    pub(crate) fn target_name<'a>(&'a self, bodies: &'a [Body], with: Target) -> &'a str {
+        match with {
+            Target::Obstacle(o) => self.obstacles.name(o),
+            Target::Segment { body, .. }
+            | Target::Vertex { body, .. }
+            | Target::Patch { body, .. } => &bodies[body].name,
+        }
+    }
+
+    /// For every open shell, the side of it each node of the other bodies is on at the last
+    /// solved state (the start of the step), with `active` the contacts solved there. A node
+    /// held by the shell keeps the side it had (its penalty leaves it a little on the far
+    /// side); a node lying on the shell takes the side of the nodes it is joined to by members
+    /// (a body resting on the shell is on the side of its other nodes); one whose neighbours
+    /// lie on it too stays unknown and is not held.
+    pub(crate) fn record_sides(
+        &mut self,
+        bodies: &[Body],
+        parts: &[BodyPart],
+        active: &ContactSet,
+    ) {
+        let min_depth = min_depth(parts);
+        for shell in 0..self.patch_surfaces.len() {
+            let Some(surface) = self.patch_surfaces[shell].as_ref().filter(|s| s.is_open()) else {
+                continue;
+            };
+            let Some((mesh, _)) = surface.mesh(|n| position(bodies, parts, shell, n)) else {
+                continue;
+            };
+            let sides = &mut self.sides[shell];
+            for (b, body) in bodies.iter().enumerate() {
+                if b == shell {
+                    continue;
+                }
+                let mut held = vec![false; body.nodes.len()];
+                for c in &active.contacts {
+                    if let (true, Target::Patch { body: t, .. }) = (c.body == b, c.with) {
+                        if t == shell {
+                            held[c.node] = true;
+                        }
+                    }
+                }
+                let signed: Vec<Real> = (0..body.nodes.len())
+                    .map(|node| {
+                        let x = position(bodies, parts, b, node);
+                        let s =
+                            surface.shell_side(&mesh, &x, |n| position(bodies, parts, shell, n));
+                        if s.distance > min_depth {
+                            s.side * s.distance
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                let mut neighbours = vec![0.0; body.nodes.len()];
+                for member in &body.members {
+                    let [i, j] = member.nodes;
+                    neighbours[i] += signed[j];
+                    neighbours[j] += signed[i];
+                }
+                for node in 0..body.nodes.len() {
+                    if held[node] && sides[b][node] != 0 {
+                        continue;
+                    }
+                    let s = if signed[node] != 0.0 {
+                        signed[node]
+                    } else {
+                        neighbours[node]
+                    };
+                    sides[b][node] = if s > 0.0 {
+                        1
+                    } else if s < 0.0 {
+                        -1
+                    } else {
+                        0
+                    };
+                }
+            }
+        }
+    }
+
+    /// `found`, with a node that presses on a patch of the same body as in `solved` keeping the
+    /// patch of `solved` while it still projects onto it or within `KEEP_PATCH` of it: a node
+    /// on the edge between two patches (coincident faces of two boxes, sliding sideways by
+    /// round-off as the bodies squeeze) is then not moved from one to the other at every
+    /// query, which made the set flip back and forth. The force goes to the kept patch's nodes
+    /// (equal and opposite all the same); on a curved surface the depth measured from the kept
+    /// patch's plane differs by about (distance beyond its edge)² / radius.
+    pub(crate) fn keep_patches(
+        &self,
+        bodies: &[Body],
+        parts: &[BodyPart],
+        solved: &ContactSet,
+        found: ContactSet,
+    ) -> ContactSet {
+        let before: HashMap<(usize, usize), Target> = solved
+            .contacts
+            .iter()
+            .map(|c| ((c.body, c.node), c.with))
+            .collect();
+        let mut changed = false;
+        let mut contacts = found.contacts;
+        for c in &mut contacts {
+            let (Target::Patch { body, .. }, Some(&old)) = (c.with, before.get(&(c.body, c.node)))
+            else {
+                continue;
+            };
+            let Target::Patch {
+                body: old_body,
+                patch,
+            } = old
+            else {
+                continue;
+            };
+            if old_body != body || old == c.with {
+                continue;
+            }
+            let Some(surface) = self.patch_surfaces[body].as_ref() else {
+                continue;
+            };
+            let [a, b, cc] = surface.patches[patch];
+            let (pa, pb, pc) = (
+                position(bodies, parts, body, a),
+                position(bodies, parts, body, b),
+                position(bodies, parts, body, cc),
+            );
+            let cross = (pb - pa).cross(&(pc - pa));
+            let area2 = cross.norm();
+            if area2.is_nan() || area2 <= 0.0 {
+                continue;
+            }
+            let n = cross / area2;
+            let x = position(bodies, parts, c.body, c.node);
+            let p = x + n * (pa - x).dot(&n);
+            let wa = (pb - p).cross(&(pc - p)).dot(&n) / area2;
+            let wb = (pc - p).cross(&(pa - p)).dot(&n) / area2;
+            if [wa, wb, 1.0 - wa - wb].iter().all(|&w| w >= -KEEP_PATCH) {
+                c.with = old;
+                changed = true;
+            }
+        }
+        if changed {
+            ContactSet::new(contacts)
+        } else {
+            ContactSet { contacts }
+        }
+    }
+
+    /// Every node inside an obstacle (at `offsets` along their travel, m) or inside another
+    /// body, with what it is deepest in.
+    pub(crate) fn query(
+        &self,
+        bodies: &[Body],
+        parts: &[BodyPart],
+        offsets: &[Vector3<Real>],
+    ) -> ContactSet {
+        // Deformed boundary polygons and their bounding boxes (the broad phase).
+        let polygons: Vec<Option<Polygon>> = self
+            .surfaces
+            .iter()
+            .enumerate()
+            .map(|(b, s)| {
+                s.as_ref().map(|s| {
+                    let points: Vec<Vector3<Real>> = s
+                        .nodes
+                        .iter()
+                        .map(|&n| position(bodies, parts, b, n))
+                        .collect();
+                    let mut bounds = [
+                        Real::INFINITY,
+                        Real::INFINITY,
+                        -Real::INFINITY,
+                        -Real::INFINITY,
+                    ];
+                    for p in &points {
+                        bounds = [
+                            bounds[0].min(p.x),
+                            bounds[1].min(p.y),
+                            bounds[2].max(p.x),
+                            bounds[3].max(p.y),
+                        ];
+                    }
+                    (points, bounds)
+                })
+            })
+            .collect();
+        // A node on a surface at a depth of round-off (a rim node on a floor through it) does
+        // not count: it would flip in and out of the set.
+        let min_depth = min_depth(parts);
+        let meshes: Vec<_> = self
+            .patch_surfaces
+            .iter()
+            .enumerate()
+            .map(|(b, s)| {
+                s.as_ref()
+                    .and_then(|s| s.mesh(|n| position(bodies, parts, b, n)))
+            })
+            .collect();
+        let mut found = Vec::new();
+        for (b, body) in bodies.iter().enumerate() {
+            for node in 0..body.nodes.len() {
+                let x = position(bodies, parts, b, node);
+                let mut deepest: Option<(Target, Real)> = None;
+                let mut consider = |target: Target, depth: Real| {
+                    if depth > min_depth && deepest.is_none_or(|(_, d)| depth > d) {
+                        deepest = Some((target, depth));
+                    }
+                };
+                for (o, offset) in offsets.iter().enumerate() {
+                    if let Some(p) = self.obstacles.project(o, &x, offset) {
+                        consider(Target::Obstacle(o), p.depth);
+                    }
+                }
+                for (other, polygon) in polygons.iter().enumerate() {
+                    let Some((points, bounds)) = polygon else {
+                        continue;
+                    };
+                    if other == b
+                        || x.x < bounds[0]
+                        || x.y < bounds[1]
+                        || x.x > bounds[2]
+                        || x.y > bounds[3]
+                        || !inside_polygon(&x, points)
+                    {
+                        continue;
+                    }
+                    if let Some((target, depth)) = inside_boundary(other, &x, points) {
+                        consider(target, depth);
+                    }
+                }
+                for (other, mesh) in meshes.iter().enumerate() {
+                    let (Some((mesh, [lo, hi])), Some(surface)) =
+                        (mesh, &self.patch_surfaces[other])
+                    else {
+                        continue;
+                    };
+                    let open = surface.is_open();
+                    let reach = if open { self.shell_reach[other] } else { 0.0 };
+                    if other == b || (0..3).any(|k| x[k] < lo[k] - reach || x[k] > hi[k] + reach) {
+                        continue;
+                    }
+                    if open {
+                        // Two-sided: held when on the other side from where the step started.
+                        let started = self.sides[other][b][node];
+                        if started == 0 {
+                            continue;
+                        }
+                        let s = surface.shell_side(mesh, &x, |n| position(bodies, parts, other, n));
+                        if s.side * Real::from(started) < 0.0 && !s.on_rim && s.distance <= reach {
+                            consider(
+                                Target::Patch {
+                                    body: other,
+                                    patch: s.patch,
+                                },
+                                s.distance,
+                            );
+                        }
+                    } else if let Some((patch, depth)) = PatchSurface::inside(mesh, &x) {
+                        consider(Target::Patch { body: other, patch }, depth);
+                    }
+                }
+                if let Some((with, _)) = deepest {
+                    found.push(ActiveContact {
+                        body: b,
+                        node,
+                        with,
+                    });
+                }
+            }
+        }
+        ContactSet::new(found)
+    }
+}
+
+/// What a node at `x` inside the deformed boundary `points` of 2D body `body` presses on, and
+/// how deep (m): the nearest segment, or the vertex between two segments equally near.
+fn inside_boundary(
+    body: usize,
+    x: &Vector3<Real>,
+    points: &[Vector3<Real>],
+) -> Option<(Target, Real)> {
+    let distances: Vec<Real> = (0..points.len())
+        .map(|i| segment_projection(x, &points[i], &points[(i + 1) % points.len()]).distance)
+        .collect();
+    let i = (0..distances.len()).min_by(|&i, &j| distances[i].total_cmp(&distances[j]))?;
+    // Equally near the segments on both sides of a vertex (a node on a symmetry line): press
+    // on the vertex, so that neither segment is favoured.
+    let n = points.len();
+    let tie = |j: usize| (distances[j] - distances[i]).abs() <= 1e-9 * distances[i];
+    let target = if tie((i + n - 1) % n) {
+        Target::Vertex { body, vertex: i }
+    } else if tie((i + 1) % n) {
+        Target::Vertex {
+            body,
+            vertex: (i + 1) % n,
+        }
+    } else {
+        Target::Segment { body, segment: i }
+    };
+    Some((target, distances[i]))
+}
+
+/// The depth below which a node is not inside a surface, m: `MIN_DEPTH` of the smallest
+/// penetration tolerance.
+fn min_depth(parts: &[BodyPart]) -> Real {
+    MIN_DEPTH
+        * parts
+            .iter()
+            .map(|p| p.tolerance)
+            .fold(Real::INFINITY, Real::min)
+}
+
+/// Per body, the nodes that may touch something: surface nodes (3D: of its patches; 2D: of its
+/// boundary loop; all nodes when it has neither) near another body's bounding box or near an
+/// obstacle anywhere along its travel (`travels`: per obstacle, offsets sampled along it, m).
+pub(crate) fn candidate_nodes(
+    bodies: &[Body],
+    geometry: &Geometry,
+    travels: &[Vec<Vector3<Real>>],
+) -> Vec<Vec<bool>> {
+    let margin: Vec<Real> = bodies
+        .iter()
+        .map(|b| MARGIN_MEMBERS * 100.0 * penetration_tolerance(b))
+        .collect();
+    let boxes: Vec<(Vector3<Real>, Vector3<Real>)> = bodies
+        .iter()
+        .map(|b| {
+            b.nodes.iter().fold(
+                (
+                    Vector3::repeat(Real::INFINITY),
+                    Vector3::repeat(-Real::INFINITY),
+                ),
+                |(lo, hi), x| (lo.inf(x), hi.sup(x)),
+            )
+        })
+        .collect();
+    let mut out = Vec::with_capacity(bodies.len());
+    for (b, body) in bodies.iter().enumerate() {
+        let surface: Vec<usize> = match (&geometry.patch_surfaces[b], &geometry.surfaces[b]) {
+            (Some(p), _) => p.nodes.clone(),
+            (None, Some(s)) => s.nodes.clone(),
+            (None, None) => (0..body.nodes.len()).collect(),
+        };
+        let mut mark = vec![false; body.nodes.len()];
+        for node in surface {
+            let x = body.nodes[node];
+            let near_body = boxes.iter().enumerate().any(|(o, (lo, hi))| {
+                let m = margin[b].max(margin[o]);
+                o != b && (0..3).all(|k| x[k] >= lo[k] - m && x[k] <= hi[k] + m)
+            });
+            let near_obstacle = || {
+                travels.iter().enumerate().any(|(o, offsets)| {
+                    offsets.iter().any(|offset| {
+                        geometry
+                            .obstacles
+                            .project(o, &x, offset)
+                            .is_some_and(|p| p.depth >= -margin[b])
+                    })
+                })
+            };
+            mark[node] = near_body || near_obstacle();
+        }
+        out.push(mark);
+    }
+    out
+}
+
+/// `mark` plus every node within `rings` members of a marked one.
+pub(crate) fn widen(body: &Body, mark: &mut [bool], rings: usize) {
+    for _ in 0..rings {
+        let before = mark.to_vec();
+        for member in &body.members {
+            let [a, b] = member.nodes;
+            if before[a] || before[b] {
+                mark[a] = true;
+                mark[b] = true;
+            }
+        }
+    }
+}

@@ -1,0 +1,246 @@
+//! Evaluating contacts: one small function per kind of target (obstacle, patch, segment, vertex) giving depth, normal, the nodes the force acts on and the penalty.
+
+use crate::contact::boundary::segment_projection;
+use crate::contact::detect::Geometry;
+use crate::contact::patch_surface::triangle_projection;
+use crate::contact::settle::{position, BodyPart};
+use crate::contact::{ActiveContact, ContactSet, Penalty, Target};
+use crate::linkage::Body;
+use crate::Real;
+use nalgebra::Vector3;
+use std::collections::HashMap;
+
+/// A contact evaluated at the current displacements.
+pub(crate) struct Evaluated {
+    /// The contact.
+    pub(crate) contact: ActiveContact,
+    /// Penetration, m (negative: the node has come out).
+    pub(crate) depth: Real,
+    /// Outward unit normal of the surface pressed on.
+    pub(crate) normal: Option<Vector3<Real>>,
+    /// Penalty stiffness, N/m.
+    pub(crate) penalty: Penalty,
+    /// The nodes the force acts on, as (body, node, weight): the pressing node with 1, a
+    /// surface's nodes with minus their barycentric weights (momentum is conserved).
+    pub(crate) nodes: Vec<(usize, usize, Real)>,
+}
+
+/// Every contact of a set evaluated at one iterate, and the contact force they make.
+pub(crate) struct Evaluation {
+    /// The contact force on each body DOF of every body, N.
+    pub(crate) forces: Vec<Vec<Real>>,
+    /// Each contact evaluated, in the set's order (those whose target is gone left out).
+    pub(crate) list: Vec<Evaluated>,
+}
+
+/// One contact against its target, before the normal is taken from the cache: depth (m),
+/// normal, the nodes the force acts on and the penalty.
+struct Touch {
+    depth: Real,
+    normal: Option<Vector3<Real>>,
+    nodes: Vec<(usize, usize, Real)>,
+    penalty: Penalty,
+}
+
+/// Evaluate every contact of `set` at the bodies' current displacements, with the obstacles at
+/// `offsets` (m). A contact whose normal cannot be found (a node exactly on the surface) takes
+/// the last one seen in `normals`; every normal found is remembered there.
+pub(crate) fn evaluate(
+    geometry: &Geometry,
+    normals: &mut HashMap<ActiveContact, Vector3<Real>>,
+    bodies: &[Body],
+    parts: &[BodyPart],
+    set: &ContactSet,
+    offsets: &[Vector3<Real>],
+) -> Evaluation {
+    let mut f: Vec<Vec<Real>> = parts.iter().map(|p| vec![0.0; p.u.len()]).collect();
+    let mut list = Vec::with_capacity(set.len());
+    for c in &set.contacts {
+        let x = position(bodies, parts, c.body, c.node);
+        let touch = match c.with {
+            Target::Obstacle(o) => on_obstacle(geometry, parts, c, o, &x, &offsets[o]),
+            Target::Patch { body, patch } => on_patch(geometry, bodies, parts, c, body, patch, &x),
+            Target::Vertex { body, vertex } => {
+                on_vertex(geometry, bodies, parts, c, body, vertex, &x)
+            }
+            Target::Segment { body, segment } => {
+                on_segment(geometry, bodies, parts, c, body, segment, &x)
+            }
+        };
+        let Some(Touch {
+            depth,
+            normal,
+            nodes,
+            penalty,
+        }) = touch
+        else {
+            continue;
+        };
+        let normal = match normal {
+            Some(n) => {
+                normals.insert(*c, n);
+                Some(n)
+            }
+            None => normals.get(c).copied(),
+        };
+        if let Some(n) = normal {
+            let force = penalty.force(depth, &n);
+            for &(b, node, w) in &nodes {
+                let d = parts[b].dofs.dofs_per_node;
+                for k in 0..d {
+                    f[b][node * d + k] += w * force[k];
+                }
+            }
+        }
+        list.push(Evaluated {
+            contact: *c,
+            depth,
+            normal,
+            penalty,
+            nodes,
+        });
+    }
+    Evaluation { forces: f, list }
+}
+
+/// The penalty between two bodies: the softer of their penalties.
+fn pair_penalty(parts: &[BodyPart], a: usize, b: usize) -> Penalty {
+    Penalty {
+        stiffness: parts[a].penalty.stiffness.min(parts[b].penalty.stiffness),
+    }
+}
+
+/// A node at `x` against obstacle `o` at `offset` (m): the pressing node alone.
+fn on_obstacle(
+    geometry: &Geometry,
+    parts: &[BodyPart],
+    c: &ActiveContact,
+    o: usize,
+    x: &Vector3<Real>,
+    offset: &Vector3<Real>,
+) -> Option<Touch> {
+    let p = geometry.obstacles.project(o, x, offset)?;
+    Some(Touch {
+        depth: p.depth,
+        normal: p.normal,
+        nodes: vec![(c.body, c.node, 1.0)],
+        penalty: parts[c.body].penalty,
+    })
+}
+
+/// A node at `x` against `patch` of 3D body `body`: the force spread over the patch's corners.
+fn on_patch(
+    geometry: &Geometry,
+    bodies: &[Body],
+    parts: &[BodyPart],
+    c: &ActiveContact,
+    body: usize,
+    patch: usize,
+    x: &Vector3<Real>,
+) -> Option<Touch> {
+    let surface = geometry.patch_surfaces[body].as_ref()?;
+    let [a, b, cc] = surface.patches[patch];
+    let mut t = triangle_projection(
+        x,
+        &position(bodies, parts, body, a),
+        &position(bodies, parts, body, b),
+        &position(bodies, parts, body, cc),
+    );
+    if surface.is_open() {
+        // Pushed back to the side the node started the step on: behind the patch, the normal
+        // turns round and the depth is measured from there.
+        let side = Real::from(geometry.sides[body][c.body][c.node]);
+        t.normal = t.normal.map(|n| n * side);
+        t.depth *= side;
+    }
+    Some(Touch {
+        depth: t.depth,
+        normal: t.normal,
+        nodes: vec![
+            (c.body, c.node, 1.0),
+            (body, a, -t.weights[0]),
+            (body, b, -t.weights[1]),
+            (body, cc, -t.weights[2]),
+        ],
+        penalty: pair_penalty(parts, c.body, body),
+    })
+}
+
+/// A node at `x` against `vertex` of 2D body `body`'s boundary: along the mean of the normals
+/// of the vertex's two segments.
+fn on_vertex(
+    geometry: &Geometry,
+    bodies: &[Body],
+    parts: &[BodyPart],
+    c: &ActiveContact,
+    body: usize,
+    vertex: usize,
+    x: &Vector3<Real>,
+) -> Option<Touch> {
+    let surface = geometry.surfaces[body].as_ref()?;
+    let (before, v) = surface.segment(surface.previous(vertex));
+    let (_, after) = surface.segment(vertex);
+    let corner = position(bodies, parts, body, v);
+    let n = segment_projection(x, &position(bodies, parts, body, before), &corner)
+        .normal
+        .unwrap_or_default()
+        + segment_projection(x, &corner, &position(bodies, parts, body, after))
+            .normal
+            .unwrap_or_default();
+    let normal = (n.norm() > 0.0).then(|| n.normalize());
+    let depth = normal.map_or(0.0, |n| (corner - x).dot(&n));
+    Some(Touch {
+        depth,
+        normal,
+        nodes: vec![(c.body, c.node, 1.0), (body, v, -1.0)],
+        penalty: pair_penalty(parts, c.body, body),
+    })
+}
+
+/// A node at `x` against `segment` of 2D body `body`'s boundary: the force shared by the
+/// segment's ends.
+fn on_segment(
+    geometry: &Geometry,
+    bodies: &[Body],
+    parts: &[BodyPart],
+    c: &ActiveContact,
+    body: usize,
+    segment: usize,
+    x: &Vector3<Real>,
+) -> Option<Touch> {
+    let surface = geometry.surfaces[body].as_ref()?;
+    let (a, b) = surface.segment(segment);
+    let pa = position(bodies, parts, body, a);
+    let pb = position(bodies, parts, body, b);
+    let mut s = segment_projection(x, &pa, &pb);
+    // Nearest to an end: that vertex is pressed, along the mean of the normals of its two
+    // segments (which of the two was found does not matter then).
+    let vertex = if s.t <= 0.0 {
+        let (before, _) = surface.segment(surface.previous(segment));
+        Some((pa, position(bodies, parts, body, before), pa, pb))
+    } else if s.t >= 1.0 {
+        let (_, after) = surface.segment(surface.next(segment));
+        Some((pb, pa, pb, position(bodies, parts, body, after)))
+    } else {
+        None
+    };
+    if let Some((corner, p0, p1, p2)) = vertex {
+        let n = segment_projection(x, &p0, &p1).normal.unwrap_or_default()
+            + segment_projection(x, &p1, &p2).normal.unwrap_or_default();
+        if n.norm() > 0.0 {
+            let n = n.normalize();
+            s.normal = Some(n);
+            s.depth = (corner - x).dot(&n);
+        }
+    }
+    Some(Touch {
+        depth: s.depth,
+        normal: s.normal,
+        nodes: vec![
+            (c.body, c.node, 1.0),
+            (body, a, -(1.0 - s.t)),
+            (body, b, -s.t),
+        ],
+        penalty: pair_penalty(parts, c.body, body),
+    })
+}

@@ -1,0 +1,155 @@
+//! The report of a settled step: each body's state, the contacts each node receives, the totals per pair, and the warnings.
+
+use crate::contact::evaluate::Evaluation;
+use crate::contact::settle::{BodyPart, Problem};
+use crate::contact::{ContactError, NodeContact};
+use crate::linkage::body_state::{internal_force_vector, member_response_at, norm};
+use crate::linkage::{post_process, StepState};
+use crate::Real;
+use nalgebra::Vector3;
+
+/// A solved step of a scene with contact.
+#[derive(Clone, Debug, Default)]
+pub struct ContactStep {
+    /// Per body, in scene order.
+    pub states: Vec<StepState>,
+    /// Per body, the nodes pressing on an obstacle or another body.
+    pub contacts: Vec<Vec<NodeContact>>,
+    /// Contact iterations (solves with a fixed contact set) the step took.
+    pub contact_iterations: usize,
+    /// Newton iterations, all contact iterations together.
+    pub newton_iterations: usize,
+    /// Largest penetration at the solution, m.
+    pub max_penetration: Real,
+    /// What the user should know: penetration above tolerance, a contact set that did not
+    /// settle.
+    pub warnings: Vec<String>,
+    /// Whether some iteration needed the stabilisation (a body held only by contact).
+    pub stabilised: bool,
+    /// Per body, the total contact force it receives from each obstacle or body it touches,
+    /// as (name of the other, force in N), in name order.
+    pub totals: Vec<Vec<(String, Vector3<Real>)>>,
+}
+
+/// States, contacts and penetration of the settled step of `p` into `out`, from its contacts
+/// `evaluated` at the solution.
+pub(crate) fn finish(
+    p: &Problem,
+    parts: &[BodyPart],
+    evaluated: Evaluation,
+    mut out: ContactStep,
+) -> Result<ContactStep, ContactError> {
+    let (bodies, forces, step) = (p.bodies, p.forces, p.step);
+    let Evaluation { forces: all, list } = evaluated;
+    // Per body, per node touched: (what it touches, deepest depth, force received).
+    let mut touched: Vec<Vec<NodeContact>> = vec![Vec::new(); bodies.len()];
+    for e in &list {
+        let name = p.geometry.target_name(bodies, e.contact.with).to_string();
+        let force = e
+            .normal
+            .map_or(Vector3::zeros(), |n| e.penalty.force(e.depth, &n));
+        out.max_penetration = out.max_penetration.max(e.depth);
+        let part = &parts[e.contact.body];
+        if e.depth > part.tolerance {
+            out.warnings.push(format!(
+                "step {step}: node {} of body '{}' is {:.3e} m inside '{name}' (tolerance {:.3e} m): raise [contact] penalty",
+                e.contact.node + 1,
+                bodies[e.contact.body].name,
+                e.depth,
+                part.tolerance
+            ));
+        }
+        for (k, &(b, node, w)) in e.nodes.iter().enumerate() {
+            // The pressing node touches the target; a surface node touches the pressing body.
+            let (with, depth) = if k == 0 {
+                (name.clone(), e.depth.max(0.0))
+            } else {
+                (bodies[e.contact.body].name.clone(), 0.0)
+            };
+            let list = &mut touched[b];
+            match list.iter_mut().find(|t| t.node == node && t.with == with) {
+                Some(t) => {
+                    t.depth = t.depth.max(depth);
+                    t.force += force * w;
+                }
+                None => list.push(NodeContact {
+                    node,
+                    with,
+                    depth,
+                    force: force * w,
+                }),
+            }
+        }
+    }
+    for ((b, body), fc) in bodies.iter().enumerate().zip(all) {
+        let part = &parts[b];
+        let d = part.dofs.dofs_per_node;
+        let mut internal = internal_force_vector(body, &part.u);
+        for (i, f) in internal.iter_mut().zip(&fc) {
+            *i -= f;
+        }
+        let members = (0..body.members.len()).map(|m| {
+            let r = member_response_at(body, &part.u, m);
+            (r.strain, r.force)
+        });
+        let mut state = post_process(body, &part.dofs, &part.u, &forces[b], &internal, members);
+        state.iterations = out.newton_iterations;
+        // Relative to the largest of applied, reaction and contact forces (a body held by
+        // contact alone has no reactions), and at least the force floor.
+        let out_of_balance = part
+            .dofs
+            .free
+            .iter()
+            .map(|&dof| (internal[dof] - forces[b][dof]).powi(2))
+            .sum::<Real>()
+            .sqrt();
+        let reacted = part
+            .dofs
+            .supported
+            .iter()
+            .map(|&dof| (internal[dof] - forces[b][dof]).powi(2))
+            .sum::<Real>()
+            .sqrt();
+        let scale = norm(&forces[b])
+            .max(reacted)
+            .max(norm(&fc))
+            .max(p.force_floor);
+        state.residual = if scale > 0.0 {
+            out_of_balance / scale
+        } else {
+            out_of_balance
+        };
+        if !state.residual.is_finite()
+            || state
+                .displacements
+                .iter()
+                .any(|u| !u.iter().all(|c| c.is_finite()))
+        {
+            return Err(ContactError::NotFinite { step });
+        }
+        let mut contacts = std::mem::take(&mut touched[b]);
+        for c in &mut contacts {
+            for k in d..3 {
+                c.force[k] = 0.0;
+            }
+        }
+        contacts.sort_by(|a, b| a.node.cmp(&b.node).then(a.with.cmp(&b.with)));
+        out.totals.push(totals(&contacts));
+        out.states.push(state);
+        out.contacts.push(contacts);
+    }
+    Ok(out)
+}
+
+/// The total force of `contacts` per body or obstacle touched, N, in name order.
+fn totals(contacts: &[NodeContact]) -> Vec<(String, Vector3<Real>)> {
+    let mut totals: Vec<(String, Vector3<Real>)> = Vec::new();
+    for c in contacts {
+        match totals.iter_mut().find(|(with, _)| *with == c.with) {
+            Some((_, f)) => *f += c.force,
+            None => totals.push((c.with.clone(), c.force)),
+        }
+    }
+    totals.sort_by(|a, b| a.0.cmp(&b.0));
+    totals
+}
