@@ -32,11 +32,20 @@
 //! [`linkage::BodySolver`] picks the solver a body needs.
 //!
 //! The scene files, the load-step driver and the result files live in [`scene`].
+//!
+//! The layers, each knowing only those before it:
+//! - [`linalg`]: sparse matrices, knowing nothing of bodies: Cholesky and LDLᵀ (faer, METIS),
+//!   conjugate gradients and their preconditioners (block Jacobi, smoothed aggregation).
+//! - [`linkage`]: the paper's model and its equilibrium: bodies, members, assembly, the
+//!   body-state kernel, the linear solve and Newton.
+//! - [`contact`]: deformed bodies against each other and rigid obstacles (parry, rapier).
+//! - [`scene`]: scene files, the load-step driver, result writers and readers.
+//! - [`render`]: pictures of results; [`bench`]: `linkage bench`.
+#![warn(missing_docs)]
 
 /// The one scalar type: SI units throughout (m, N, Pa, m²).
 pub type Real = f64;
 
-pub mod atomic_file;
 pub mod bench;
 pub mod contact;
 pub mod linalg;

@@ -125,87 +125,139 @@ pub enum BodyError {
     /// A material with a bad value.
     #[error("body '{body}': material '{material}': {problem}")]
     Material {
+        /// Body name.
         body: String,
+        /// Material name.
         material: String,
+        /// What is wrong and what to do.
         problem: String,
     },
     /// A node coordinate that is NaN or infinite.
     #[error("body '{body}': node {node} has a non-finite coordinate {value}: give finite numbers in metres")]
     NonFiniteNode {
+        /// Body name.
         body: String,
+        /// The node, 1-based.
         node: usize,
+        /// The coordinate given, m.
         value: Real,
     },
     /// A 2D body with a node off the plane z = 0.
     #[error("body '{body}': node {node} has z = {z} but the body is 2D: 2D nodes lie in the plane z = 0")]
-    NodeOffPlane { body: String, node: usize, z: Real },
+    NodeOffPlane {
+        /// Body name.
+        body: String,
+        /// The node, 1-based.
+        node: usize,
+        /// Its z coordinate, m.
+        z: Real,
+    },
     /// A member whose node number does not exist.
     #[error("body '{body}': member {member} names node {node}, but the body has {count} nodes (numbers start at 1)")]
     NodeOutOfRange {
+        /// Body name.
         body: String,
+        /// The member, 1-based.
         member: usize,
+        /// The node, 1-based.
         node: usize,
+        /// Nodes the body has.
         count: usize,
     },
     /// A member joining a node to itself.
     #[error("body '{body}': member {member} joins node {node} to itself: a member needs two different nodes")]
     SelfMember {
+        /// Body name.
         body: String,
+        /// The member, 1-based.
         member: usize,
+        /// The node, 1-based.
         node: usize,
     },
     /// A member whose nodes coincide.
     #[error("body '{body}': member {member} joins nodes {a} and {b}, which are at the same place (length {length:e} m): move one node or merge them")]
     ZeroLength {
+        /// Body name.
         body: String,
+        /// The member, 1-based.
         member: usize,
+        /// First node, 1-based.
         a: usize,
+        /// Second node, 1-based.
         b: usize,
+        /// Distance between them, m.
         length: Real,
     },
     /// Two members joining the same pair of nodes.
     #[error("body '{body}': member {member} joins nodes {a} and {b}, as member {first} already does: remove one (to stiffen a link, use a material with a larger area)")]
     DuplicateMember {
+        /// Body name.
         body: String,
+        /// The member, 1-based.
         member: usize,
+        /// The member that joins them first, 1-based.
         first: usize,
+        /// First node, 1-based.
         a: usize,
+        /// Second node, 1-based.
         b: usize,
     },
     /// A member whose material index does not exist.
     #[error("body '{body}': member {member} refers to material #{material}, which does not exist")]
     MaterialOutOfRange {
+        /// Body name.
         body: String,
+        /// The member, 1-based.
         member: usize,
+        /// The material's number, 1-based.
         material: usize,
     },
     /// A patch that names a missing node or repeats a node.
     #[error("body '{body}': patch {patch} ({nodes:?}) {problem}")]
     BadPatch {
+        /// Body name.
         body: String,
+        /// The patch, 1-based.
         patch: usize,
+        /// Its nodes as given.
         nodes: [usize; 3],
+        /// What is wrong and what to do.
         problem: String,
     },
     /// A node that no member touches: it could move freely.
     #[error("body '{body}': node {node} belongs to no member, so nothing holds it: join it with members or remove it")]
-    LooseNode { body: String, node: usize },
+    LooseNode {
+        /// Body name.
+        body: String,
+        /// The node, 1-based.
+        node: usize,
+    },
     /// A body with no supports at all.
     #[error("body '{body}' has no supports, so it can move as a rigid body: add [[bodies.supports]] that hold it")]
-    NoSupports { body: String },
+    NoSupports {
+        /// Body name.
+        body: String,
+    },
     /// A support or load on a node that does not exist.
     #[error("body '{body}': {what} names node {node}, but the body has {count} nodes")]
     TargetOutOfRange {
+        /// Body name.
         body: String,
+        /// What names it (a support, a load, a key).
         what: String,
+        /// The node, 1-based.
         node: usize,
+        /// Nodes the body has.
         count: usize,
     },
     /// A non-finite load, displacement or schedule, or a z component in 2D.
     #[error("body '{body}': {what}: {problem}")]
     BadValue {
+        /// Body name.
         body: String,
+        /// What names it (a support, a load, a key).
         what: String,
+        /// What is wrong and what to do.
         problem: String,
     },
 }
@@ -458,13 +510,33 @@ impl Body {
 #[derive(Debug, Clone, PartialEq)]
 pub enum MemberProblem {
     /// A node index past the end.
-    NodeOutOfRange { member: usize, node: usize },
+    NodeOutOfRange {
+        /// The member, 0-based.
+        member: usize,
+        /// The node index it names, 0-based.
+        node: usize,
+    },
     /// Both ends the same node.
-    SelfMember { member: usize, node: usize },
+    SelfMember {
+        /// The member, 0-based.
+        member: usize,
+        /// The node, 0-based.
+        node: usize,
+    },
     /// The two nodes coincide.
-    ZeroLength { member: usize, length: Real },
+    ZeroLength {
+        /// The member, 0-based.
+        member: usize,
+        /// Its length, m.
+        length: Real,
+    },
     /// The same pair as an earlier member.
-    Duplicate { member: usize, first: usize },
+    Duplicate {
+        /// The member, 0-based.
+        member: usize,
+        /// The earlier member joining the same nodes, 0-based.
+        first: usize,
+    },
 }
 
 impl MemberProblem {

@@ -1,10 +1,10 @@
 //! The pictures of a whole run: PNG frames and the GIF of its stored steps, drawn from its
 //! results in memory (during `linkage run`) or read back from a results folder (`linkage render`).
 
-use crate::atomic_file::write_atomically;
 use crate::render::{
     draw_frame, GifAnimation, RenderError, RenderOptions, RunExtent, StepSelection,
 };
+use crate::scene::atomic_file::write_atomically;
 use crate::scene::{DrawResults, RunResults, StoredRun, World};
 use std::path::{Path, PathBuf};
 

@@ -17,6 +17,7 @@ pub use self::vtk::{write_vtk, VtkError};
 pub use self::world::{OutputSettings, World};
 pub use self::writers::DrawResults;
 
+pub mod atomic_file;
 mod build;
 mod driver;
 mod mesh_file;

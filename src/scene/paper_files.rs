@@ -3,8 +3,8 @@
 //! per line, 1-based). Columns are separated by spaces or tabs, `#` starts a comment anywhere
 //! on a line, and blank lines are ignored; the n-th data line is node (member, patch) n.
 
-use crate::atomic_file::write_atomically;
 use crate::linkage::{check_members, Dimension, MemberProblem};
+use crate::scene::atomic_file::write_atomically;
 use crate::Real;
 use nalgebra::Vector3;
 use std::fmt::Write as _;

@@ -15,8 +15,8 @@
 //! data `obstacle`: 1-based, in scene order; field data: one Int32 array per obstacle, named
 //! after it, holding its number.
 
-use crate::atomic_file::write_atomically;
 use crate::contact::cut_by_z0;
+use crate::scene::atomic_file::write_atomically;
 use crate::scene::model_file::{ModelBody, ModelFile};
 use crate::scene::results::{BodyResult, StepResult};
 use crate::scene::run_results::RunResults;

@@ -1,7 +1,7 @@
 //! What a run writes, handed its results in memory: each step file as the step is solved, then
 //! `model.json`, VTK files and pictures into the staging folder before it is published.
 
-use crate::atomic_file::write_atomically;
+use crate::scene::atomic_file::write_atomically;
 use crate::scene::model_file::ModelFile;
 use crate::scene::results::{PhaseSeconds, StepResult};
 use crate::scene::run_error::RunError;
