@@ -25,6 +25,7 @@ mod model_file;
 mod obstacles;
 pub mod paper_files;
 mod pictures;
+pub mod publish;
 mod results;
 mod run_error;
 mod run_results;
