@@ -1,22 +1,23 @@
 //! The load-step driver: step a [`Simulation`] through a world's load steps and hand each
 //! result to the writers, in a staging folder published when complete.
 
-use crate::contact::ContactError;
-use crate::linkage::SolveError;
+use crate::scene::publish::{destination, publish, remove_stale, staging_dir};
 use crate::scene::results::{PhaseSeconds, Summary};
 use crate::scene::run_error::RunError;
 use crate::scene::simulation::Simulation;
 use crate::scene::writers::{keeps_steps, write_after_steps, write_json, write_step, DrawResults};
 use crate::scene::World;
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Run `world` and write `out/<name>/` (summary.json and steps/NNNN.json). The folder is
-/// built under a temporary name and renamed when complete, so an interrupted or failed run
-/// leaves no partial results (and an earlier complete run stays until replaced).
-/// `on_step` is called after each solved step (for progress bars). Also writes `model.json`
-/// and the VTK files `world.pictures` asks for; pictures need [`run_with`].
+/// built under a staging name and put in place when complete (see [`crate::scene::publish`]):
+/// an interrupted run leaves nothing, a run whose step after step 0 cannot be solved keeps step
+/// 0 and the steps solved before it (beside earlier complete results, never over them), and
+/// files a user keeps in the folder survive a re-run. `on_step` is called after each solved
+/// step (for progress bars). Also writes `model.json` and the VTK files `world.pictures` asks
+/// for; pictures need [`run_with`].
 pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Summary, RunError> {
     run_with(world, out, on_step, None)
 }
@@ -29,29 +30,36 @@ pub fn run_with(
     on_step: &(dyn Fn() + Sync),
     draw: Option<&dyn DrawResults>,
 ) -> Result<Summary, RunError> {
+    run_until(world, out, on_step, draw, &AtomicBool::new(false))
+}
+
+/// [`run_with`], stopping before the next step once `stop` is set (the CLI sets it on SIGINT
+/// and SIGTERM): the staging folder is removed and [`RunError::Interrupted`] returned.
+pub fn run_until(
+    world: &World,
+    out: &Path,
+    on_step: &(dyn Fn() + Sync),
+    draw: Option<&dyn DrawResults>,
+    stop: &AtomicBool,
+) -> Result<Summary, RunError> {
     let final_dir = out.join(&world.name);
-    // Unique per run, so two runs of one name in a batch never share a staging folder.
-    static RUNS: AtomicUsize = AtomicUsize::new(0);
-    let staging = out.join(format!(
-        ".{}.partial-{}-{}",
-        world.name,
-        std::process::id(),
-        RUNS.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = run_in(world, &staging, &final_dir, on_step, draw);
+    remove_stale(out, &world.name);
+    let staging = staging_dir(out, &world.name);
+    let result = run_in(world, &staging, &final_dir, on_step, draw, stop);
     if staging.exists() {
         let _ = std::fs::remove_dir_all(&staging);
     }
     result
 }
 
-/// The run of [`run_with`], written into `staging` and moved to `final_dir` when complete.
+/// The run of [`run_with`], written into `staging` and published when complete or stopped.
 fn run_in(
     world: &World,
     staging: &Path,
     final_dir: &Path,
     on_step: &(dyn Fn() + Sync),
     draw: Option<&dyn DrawResults>,
+    stop: &AtomicBool,
 ) -> Result<Summary, RunError> {
     let write_err = |path: &Path| {
         let path = path.to_path_buf();
@@ -77,25 +85,20 @@ fn run_in(
     let mut kept = Vec::new();
     let mut stopped = None;
     for step in 0..=world.steps {
+        if stop.load(Ordering::Relaxed) {
+            return Err(RunError::Interrupted {
+                scene: world.source.clone(),
+                step,
+            });
+        }
         let t = Instant::now();
         let (result, mut line) = match simulation.step(step) {
             Ok(solved) => solved,
-            // A nonlinear step that cannot be solved ends the run, but the steps before it
+            // A step after step 0 that cannot be solved ends the run, but the steps before it
             // are kept and the summary says why it stopped.
-            Err(RunError::Solve {
-                scene,
-                source: source @ SolveError::NotConverged { .. },
-            }) => {
-                summary.failure = Some(source.to_string());
-                stopped = Some(RunError::Solve { scene, source });
-                break;
-            }
-            Err(RunError::Contact {
-                scene,
-                source: source @ ContactError::NotConverged { .. },
-            }) => {
-                summary.failure = Some(source.to_string());
-                stopped = Some(RunError::Contact { scene, source });
+            Err(e) if step > 0 => {
+                summary.failure = Some(failure_text(&e));
+                stopped = Some(e);
                 break;
             }
             Err(e) => return Err(e),
@@ -117,27 +120,22 @@ fn run_in(
     summary.phases.contact_query += query;
     write_after_steps(world, kept, staging, draw, &mut summary.phases)?;
     write_json(&staging.join("summary.json"), &summary, true)?;
-    replace_dir(staging, final_dir).map_err(write_err(final_dir))?;
+    let target = destination(final_dir, stopped.is_none());
+    publish(staging, &target).map_err(write_err(&target))?;
     match stopped {
-        Some(e) => Err(e),
+        Some(e) => Err(RunError::Stopped {
+            results: target,
+            source: Box::new(e),
+        }),
         None => Ok(summary),
     }
 }
 
-/// Put the complete folder `from` at `to`, replacing an earlier one.
-fn replace_dir(from: &Path, to: &Path) -> std::io::Result<()> {
-    if to.exists() {
-        let old = to.with_file_name(format!(
-            ".{}.old-{}",
-            to.file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default(),
-            std::process::id()
-        ));
-        std::fs::rename(to, &old)?;
-        std::fs::rename(from, to)?;
-        std::fs::remove_dir_all(&old)
-    } else {
-        std::fs::rename(from, to)
+/// The summary's `failure`: why the step failed, without the scene file the error names.
+fn failure_text(e: &RunError) -> String {
+    match e {
+        RunError::Solve { source, .. } => source.to_string(),
+        RunError::Contact { source, .. } => source.to_string(),
+        other => other.to_string(),
     }
 }

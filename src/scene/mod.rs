@@ -1,7 +1,7 @@
 //! Scene files, the load-step driver and the result files.
 
 pub use self::build::{build_world, load_scene, SceneError};
-pub use self::driver::{run, run_with};
+pub use self::driver::{run, run_until, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::results::{

@@ -31,6 +31,23 @@ pub enum RunError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// A step could not be solved after step 0: the steps solved before it were written to
+    /// `results` (beside earlier complete results of the scene, never over them).
+    #[error("{source}; the steps solved before it are in {}", results.display())]
+    Stopped {
+        /// The folder holding step 0 up to the last solved step and the summary.
+        results: PathBuf,
+        /// Why the step failed.
+        source: Box<RunError>,
+    },
+    /// The run was asked to stop (SIGINT, SIGTERM) before it finished; nothing was written.
+    #[error("{scene}: interrupted before step {step}: no results written (earlier results of the scene are untouched)")]
+    Interrupted {
+        /// Scene file.
+        scene: PathBuf,
+        /// The step that was not started.
+        step: usize,
+    },
     /// Pictures or VTK files could not be made.
     #[error("{path}: {source}")]
     Draw {
