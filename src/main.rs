@@ -4,10 +4,11 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
-use linkage::scene::{load_scene, run_with, Summary, World};
+use linkage::scene::{load_scene, run_until, Summary, World};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 #[derive(Parser)]
@@ -170,6 +171,13 @@ fn parse_cells(s: &str) -> Result<[usize; 3], String> {
     Ok(out)
 }
 
+/// Set by SIGINT or SIGTERM: every run stops before its next step and removes its staging
+/// folder (a second signal exits at once; the next run removes what that leaves).
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Exit status of a run stopped by a signal (128 + SIGINT, as shells report it).
+const INTERRUPTED: u8 = 130;
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
@@ -210,8 +218,27 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            if STOP.load(Ordering::SeqCst) {
+                ExitCode::from(INTERRUPTED)
+            } else {
+                ExitCode::FAILURE
+            }
         }
+    }
+}
+
+/// Make SIGINT and SIGTERM stop the runs cleanly (see [`STOP`]); without a handler the runs
+/// could not clean up, so say so and go on.
+fn catch_signals() {
+    if let Err(e) = ctrlc::set_handler(|| {
+        if STOP.swap(true, Ordering::SeqCst) {
+            std::process::exit(i32::from(INTERRUPTED));
+        }
+        eprintln!(
+            "interrupted: stopping after the current step and removing partial results (again to quit at once)"
+        );
+    }) {
+        eprintln!("warning: cannot catch SIGINT/SIGTERM ({e}): an interrupted run may leave a staging folder, removed by the next run");
     }
 }
 
@@ -222,6 +249,7 @@ fn run_scenes(
     png: bool,
     vtk: bool,
 ) -> Result<()> {
+    catch_signals();
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create the output folder {}", out.display()))?;
     let bar = ProgressBar::new(0);
@@ -238,7 +266,7 @@ fn run_scenes(
         }
         world.pictures.vtk |= vtk;
         bar.inc_length(world.steps as u64 + 1);
-        let summary = run_with(&world, out, &|| bar.inc(1), Some(&PictureWriter))?;
+        let summary = run_until(&world, out, &|| bar.inc(1), Some(&PictureWriter), &STOP)?;
         Ok((world, summary, t.elapsed().as_secs_f64()))
     };
     let work =

@@ -516,7 +516,12 @@ force = [0.0, -9000.0]   # 1.18 times the limit load (7622 N)
     let again = dir.path().join("again");
     let err = linkage::scene::run(&world, &again, &|| {}).expect_err("step 4 cannot be solved");
     let message = err.to_string();
-    match err {
+    let RunError::Stopped { results, source } = err else {
+        panic!("expected a run stopped after its solved steps, got {err:?}");
+    };
+    // No earlier results: the solved steps are the scene's folder.
+    assert_eq!(results, again.join("overload"));
+    match *source {
         RunError::Solve {
             scene: file,
             source:
@@ -539,7 +544,8 @@ force = [0.0, -9000.0]   # 1.18 times the limit load (7622 N)
     assert!(
         message.contains("overload.toml")
             && message.contains("Use more steps")
-            && message.contains("method = \"arc_length\""),
+            && message.contains("method = \"arc_length\"")
+            && message.contains("the steps solved before it are in"),
         "{message}"
     );
     assert!(again.join("overload/steps/0003.json").is_file());
