@@ -1,6 +1,8 @@
 //! Large displacements: geometrically exact members solved by Newton (issue 4). Every check
 //! is against a closed form or an exact property, with its tolerance stated where it is used.
 
+mod common;
+
 use linkage::linkage::{
     Behaviour, Body, BodyError, BodySolver, Dimension, Kinematics, Material, Member,
     NewtonEquilibrium, NodalLoad, PathMethod, Schedule, SolveError, StepState, Support,
@@ -440,36 +442,8 @@ fn von_mises_truss_snap_through_by_arc_length() {
 #[test]
 fn load_beyond_the_limit_point_stops_with_the_solved_steps_kept() {
     let dir = tempfile::tempdir().unwrap();
-    let here = std::env::current_dir().unwrap().join("scenes");
-    let scene = dir.path().join("overload.toml");
-    std::fs::write(
-        &scene,
-        format!(
-            r#"name = "overload"
-steps = 4
-[[materials]]
-name = "steel"
-youngs_modulus = 200e9
-area = 1e-4
-[[bodies]]
-name = "truss"
-nodes = "{}"
-links = "{}"
-kinematics = "large"
-[bodies.newton]
-max_cuts = 3
-[[bodies.supports]]
-nodes = [1, 3]
-fix = ["x", "y"]
-[[bodies.loads]]
-nodes = [2]
-force = [0.0, -9000.0]   # 1.18 times the limit load (7622 N)
-"#,
-            here.join("von_mises.nodes").display(),
-            here.join("von_mises.links").display()
-        ),
-    )
-    .unwrap();
+    // 9000 N: 1.18 times the limit load (7622 N).
+    let scene = common::truss_scene(dir.path(), "overload.toml", "overload", 9000.0);
     let out = dir.path().join("out");
     let run = std::process::Command::new(env!("CARGO_BIN_EXE_linkage"))
         .arg("run")

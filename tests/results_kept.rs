@@ -1,47 +1,12 @@
 //! A run never loses results: failed re-runs, a user's files, signals, killed runs, and runs of
 //! one name finishing together.
 
+mod common;
+
 use linkage::scene::{load_scene, run, RunError};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-/// The von Mises truss under load control with `force` N down at its apex: 7622 N is its
-/// limit load, so 5000 N solves and 9000 N fails at step 4 of 4.
-fn truss_scene(dir: &Path, file: &str, force: f64) -> PathBuf {
-    let here = std::env::current_dir().unwrap().join("scenes");
-    let scene = dir.join(file);
-    std::fs::write(
-        &scene,
-        format!(
-            r#"name = "truss"
-steps = 4
-[[materials]]
-name = "steel"
-youngs_modulus = 200e9
-area = 1e-4
-[[bodies]]
-name = "truss"
-nodes = "{}"
-links = "{}"
-kinematics = "large"
-[bodies.newton]
-max_cuts = 3
-[[bodies.supports]]
-nodes = [1, 3]
-fix = ["x", "y"]
-[[bodies.loads]]
-nodes = [2]
-force = [0.0, {}]
-"#,
-            here.join("von_mises.nodes").display(),
-            here.join("von_mises.links").display(),
-            -force
-        ),
-    )
-    .unwrap();
-    scene
-}
 
 fn summary(dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap()
@@ -62,12 +27,24 @@ fn listing(dir: &Path) -> Vec<String> {
 fn a_failed_rerun_leaves_the_complete_results_and_puts_its_own_beside_them() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let good = load_scene(&truss_scene(dir.path(), "good.toml", 5000.0)).unwrap();
+    let good = load_scene(&common::truss_scene(
+        dir.path(),
+        "good.toml",
+        "truss",
+        5000.0,
+    ))
+    .unwrap();
     run(&good, &out, &|| {}).unwrap();
     let complete = out.join("truss");
     let before = std::fs::read(complete.join("steps/0004.json")).unwrap();
 
-    let bad = load_scene(&truss_scene(dir.path(), "bad.toml", 9000.0)).unwrap();
+    let bad = load_scene(&common::truss_scene(
+        dir.path(),
+        "bad.toml",
+        "truss",
+        9000.0,
+    ))
+    .unwrap();
     let err = run(&bad, &out, &|| {}).expect_err("step 4 cannot be solved");
     let RunError::Stopped { results, source } = &err else {
         panic!("expected a stopped run, got {err:?}");
@@ -99,7 +76,13 @@ fn a_failed_rerun_leaves_the_complete_results_and_puts_its_own_beside_them() {
 fn a_users_files_in_the_results_folder_survive_a_rerun() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let good = load_scene(&truss_scene(dir.path(), "good.toml", 5000.0)).unwrap();
+    let good = load_scene(&common::truss_scene(
+        dir.path(),
+        "good.toml",
+        "truss",
+        5000.0,
+    ))
+    .unwrap();
     run(&good, &out, &|| {}).unwrap();
     let folder = out.join("truss");
     std::fs::write(folder.join("notes.txt"), "the second design").unwrap();
@@ -128,7 +111,7 @@ fn a_stale_staging_folder_of_a_dead_process_is_removed_by_the_next_run() {
     std::fs::write(stale.join("steps/0000.json"), "{}").unwrap();
     let other = out.join(".other.partial-4194305-0");
     std::fs::create_dir_all(&other).unwrap();
-    let scene = truss_scene(dir.path(), "good.toml", 5000.0);
+    let scene = common::truss_scene(dir.path(), "good.toml", "truss", 5000.0);
     let status = Command::new(env!("CARGO_BIN_EXE_linkage"))
         .arg("run")
         .arg(&scene)
