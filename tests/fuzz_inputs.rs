@@ -695,3 +695,33 @@ fn mutated_scenes_panic_hang_write_nan_or_leave_litter_never() {
         panic!("{e}");
     }
 }
+
+/// Found by the fuzzing: `area = 1e-308` in `paper_disk.toml` gave displacements of 2e301 m,
+/// whose magnitude overflows: `max_displacement` was written as `null` in `summary.json` and
+/// the run reported success.
+#[test]
+fn an_area_of_1e_minus_308_overflows_and_is_refused_not_written_as_null() {
+    let scenes = bundled_scenes();
+    let scene = scenes.iter().find(|s| s.file == "paper_disk.toml").unwrap();
+    let files = Files {
+        scene_file: scene.file.clone(),
+        scene: scene.text.replace("area = 1e-4 ", "area = 1e-308"),
+        aux: Vec::new(),
+    };
+    assert!(files.scene.contains("area = 1e-308"));
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(&files.scene_file);
+    std::fs::write(&path, &files.scene).unwrap();
+    let out = dir.path().join("out");
+    let world = load_scene(&path).unwrap();
+    let outcome = match run(&world, &out, &|| {}) {
+        Err(RunError::Stopped { results, source }) => {
+            let message = source.to_string();
+            assert!(message.contains("overflow"), "{message}");
+            assert!(message.contains("area"), "{message}");
+            Outcome::Stopped(results)
+        }
+        other => panic!("expected a stopped run, got {other:?}"),
+    };
+    check_output(dir.path(), &files, &outcome).unwrap();
+}
