@@ -80,6 +80,15 @@ pub enum SolveError {
         /// Memory available, MB.
         available_mb: u64,
     },
+    /// The solution holds numbers beyond the range of `f64` (a material or load far out of
+    /// scale, e.g. an area of 1e-308 m²).
+    #[error("body '{body}': the {quantity} of the solution overflow (beyond 1.8e308): check the materials' youngs_modulus and area and the loads for values far out of scale")]
+    Overflow {
+        /// Body name.
+        body: String,
+        /// Which numbers, e.g. `"displacements"`.
+        quantity: &'static str,
+    },
     /// The solve returned a result that does not satisfy equilibrium.
     #[error("body '{body}': the solution misses equilibrium by {residual:e} (relative): the stiffness matrix is too ill-conditioned (members of very different stiffness, or nearly collinear members); check the materials and the geometry")]
     Inaccurate {

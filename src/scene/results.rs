@@ -218,4 +218,24 @@ impl BodyResult {
             contacts: Vec::new(),
         }
     }
+
+    /// The first of its lists holding a NaN or an infinity (which JSON cannot hold), if any:
+    /// `"displacements"`, `"positions"`, `"axial forces"`, `"strains"`, `"stresses"`,
+    /// `"reactions"` or `"loads"`.
+    pub fn non_finite(&self) -> Option<&'static str> {
+        let finite = |v: &[Real]| v.iter().all(|x| x.is_finite());
+        let nodes = |v: &[Vec<Real>]| v.iter().all(|x| finite(x));
+        let forces = |v: &[NodeForce]| v.iter().all(|f| finite(&f.force));
+        [
+            ("displacements", nodes(&self.displacements)),
+            ("positions", nodes(&self.positions)),
+            ("axial forces", finite(&self.axial_forces)),
+            ("strains", finite(&self.strains)),
+            ("stresses", finite(&self.stresses)),
+            ("reactions", forces(&self.reactions)),
+            ("loads", forces(&self.loads)),
+        ]
+        .into_iter()
+        .find_map(|(name, ok)| (!ok).then_some(name))
+    }
 }

@@ -2,7 +2,7 @@
 //! and the step's result and summary line.
 
 use crate::contact::{ContactSolver, NodeContact};
-use crate::linkage::{Body, BodySolver, PhaseTimes, StepState};
+use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
 use crate::scene::results::{
     BodyResult, BodySize, ContactForce, PairForce, StepResult, StepSummary,
 };
@@ -120,6 +120,19 @@ impl<'w> Simulation<'w> {
                 .map(|u| u.norm())
                 .fold(summary.max_displacement, Real::max);
             let mut written = BodyResult::new(body, state);
+            // Numbers that overflow (an absurd material or load) would reach the JSON as null.
+            let overflow = written.non_finite().or_else(|| {
+                (!summary.max_displacement.is_finite()).then_some("displacement magnitudes")
+            });
+            if let Some(quantity) = overflow {
+                return Err(RunError::Solve {
+                    scene: world.source.clone(),
+                    source: SolveError::Overflow {
+                        body: body.name.clone(),
+                        quantity,
+                    },
+                });
+            }
             if let Some(contacts) = contacts.get(k) {
                 written.contacts = contact_forces(body, contacts);
             }
