@@ -29,7 +29,7 @@ enum Command {
         /// Scene files (TOML).
         #[arg(required = true)]
         scenes: Vec<PathBuf>,
-        /// Output folder.
+        /// Output folder (created if missing; not a file).
         #[arg(long, default_value = "out")]
         out: PathBuf,
         /// Scenes solved at once (default: the number of cores).
@@ -42,7 +42,8 @@ enum Command {
         #[arg(long)]
         vtk: bool,
     },
-    /// Draw a stored run again (png/NNNN.png, anim.gif; --vtk for ParaView files) without solving.
+    /// Draw a stored run again (png/NNNN.png, replacing the frames in png/; anim.gif; --vtk for
+    /// ParaView files) without solving.
     Render(RenderArgs),
     /// Check scenes without solving and print model sizes.
     Check {
@@ -242,6 +243,26 @@ fn catch_signals() {
     }
 }
 
+/// Create the folder `--out` names (and its parents); a path that is a file, or lies under
+/// one, is refused with a message saying `--out` must be a folder.
+fn create_out_folder(out: &Path) -> Result<()> {
+    if let Some(file) = out.ancestors().find(|p| p.is_file()) {
+        if file == out {
+            bail!(
+                "--out {}: is a file; --out must be a folder (it is created if missing)",
+                out.display()
+            );
+        }
+        bail!(
+            "--out {}: {} is a file; --out must be a folder (it is created if missing)",
+            out.display(),
+            file.display()
+        );
+    }
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create the output folder {}", out.display()))
+}
+
 fn run_scenes(
     scenes: &[PathBuf],
     out: &Path,
@@ -250,8 +271,7 @@ fn run_scenes(
     vtk: bool,
 ) -> Result<()> {
     catch_signals();
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create the output folder {}", out.display()))?;
+    create_out_folder(out)?;
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} steps {msg}")
@@ -301,7 +321,7 @@ fn run_scenes(
                     "ok    {} -> {}: {}; {:.3} s; max |u| {:.4e} m; {} overloaded; residual {:.1e}",
                     path.display(),
                     out.join(&world.name).display(),
-                    world.describe(),
+                    world.describe_solved(summary.bodies.iter().map(|b| b.free_dofs).sum()),
                     seconds,
                     last.map_or(0.0, |s| s.max_displacement),
                     last.map_or(0, |s| s.overloaded),
@@ -309,8 +329,8 @@ fn run_scenes(
                 );
                 let p = &summary.phases;
                 println!(
-                    "      phases: assembly {:.3} s, ordering+symbolic {:.3} s, factorization {:.3} s, solve {:.3} s, writing {:.3} s, drawing {:.3} s",
-                    p.assembly, p.symbolic, p.numeric, p.solve, p.writing, p.drawing
+                    "      phases: assembly {:.3} s, ordering+symbolic {:.3} s, factorization {:.3} s, solve {:.3} s, contact_query {:.3} s, writing {:.3} s, drawing {:.3} s",
+                    p.assembly, p.symbolic, p.numeric, p.solve, p.contact_query, p.writing, p.drawing
                 );
                 // The summary's warnings (deep penetration, an unsettled contact set) matter
                 // enough to show here, not only in summary.json.
@@ -366,8 +386,7 @@ fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
 fn export(scene: &Path, out: &Path) -> Result<()> {
     use linkage::scene::paper_files::{write_links, write_nodes, write_patches};
     let world = load_scene(scene)?;
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create the output folder {}", out.display()))?;
+    create_out_folder(out)?;
     for body in &world.bodies {
         let file = |ext: &str| out.join(format!("{}.{ext}", body.name));
         let members: Vec<[usize; 2]> = body.members.iter().map(|m| m.nodes).collect();

@@ -271,3 +271,131 @@ fn export_writes_the_papers_files_that_read_back_the_same_body() {
     let again = linkage::scene::load_scene(&scene).unwrap();
     assert_eq!(again.bodies, original.bodies);
 }
+
+/// The run line gives the DOFs and the free ones, the free count being the summary's
+/// `free_dofs` summed over the bodies, and the phases line has every phase of the summary,
+/// `contact_query` among them.
+#[test]
+fn run_line_gives_the_free_dofs_of_the_summary_and_every_phase() {
+    let out = tempfile::tempdir().unwrap();
+    let o = linkage()
+        .args(["run", "scenes/paper_square.toml", "--out"])
+        .arg(out.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let summary: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(out.path().join("paper_square/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let free: u64 = summary["bodies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["free_dofs"].as_u64().unwrap())
+        .sum();
+    // The square: 4 nodes in 2D, node 3 pinned, node 4 held in y.
+    assert_eq!(free, 5);
+    assert!(stdout.contains("8 DOFs (5 free)"), "{stdout}");
+    let phases = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("phases:"))
+        .unwrap();
+    for key in summary["phases"].as_object().unwrap().keys() {
+        let shown = match key.as_str() {
+            "symbolic" => "ordering+symbolic",
+            "numeric" => "factorization",
+            k => k,
+        };
+        assert!(phases.contains(shown), "{key} missing: {phases}");
+    }
+}
+
+/// `--out` naming a file (or a path under one) says that `--out` must be a folder, not "File
+/// exists (os error 17)"; nothing is written.
+#[test]
+fn out_naming_a_file_says_it_must_be_a_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("results.txt");
+    std::fs::write(&file, "mine").unwrap();
+    for (out, command) in [
+        (file.clone(), "run"),
+        (file.join("sub"), "run"),
+        (file.clone(), "export"),
+    ] {
+        let o = linkage()
+            .args([command, "scenes/paper_square.toml", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(!o.status.success());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains("--out must be a folder") && err.contains("is a file"),
+            "{err}"
+        );
+        assert!(!err.contains("os error"), "{err}");
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), "mine");
+    }
+}
+
+/// `model.json` has a closed surface's patches outward even when the patches file gives them
+/// facing in (the tetrahedron's four faces, each counter-clockwise seen from inside).
+#[test]
+fn model_json_has_closed_surfaces_outward() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("t.nodes"), "0 0 0\n1 0 0\n0 1 0\n0 0 1\n").unwrap();
+    std::fs::write(d.join("t.links"), "1 2\n1 3\n1 4\n2 3\n2 4\n3 4\n").unwrap();
+    std::fs::write(d.join("t.patches"), "1 2 3\n1 4 2\n1 3 4\n2 4 3\n").unwrap();
+    let scene = d.join("t.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "tetra"
+steps = 1
+
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+
+[[bodies]]
+name = "t"
+nodes = "t.nodes"
+links = "t.links"
+patches = "t.patches"
+material = "steel"
+
+[[bodies.supports]]
+nodes = [1]
+fix = ["x", "y", "z"]
+
+[[bodies.supports]]
+nodes = [2]
+fix = ["y", "z"]
+
+[[bodies.supports]]
+nodes = [3]
+fix = ["z"]
+
+[[bodies.loads]]
+nodes = [4]
+force = [10.0, 0.0, 0.0]
+"#,
+    )
+    .unwrap();
+    let o = linkage()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(d.join("out"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    let model: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("out/tetra/model.json")).unwrap()).unwrap();
+    let patches: Vec<[usize; 3]> =
+        serde_json::from_value(model["bodies"][0]["patches"].clone()).unwrap();
+    assert_eq!(patches, [[1, 3, 2], [1, 2, 4], [1, 4, 3], [2, 3, 4]]);
+}

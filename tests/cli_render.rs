@@ -28,15 +28,16 @@ fn run_png_vtk_then_render_again_with_other_options() {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
 
-    // Render reads the stored run and solves nothing: the results (and the frames and GIF it
-    // is not asked for) keep their bytes and modification times, and no timing of a solve is
-    // printed; only the asked-for frame is drawn anew.
+    // Render reads the stored run and solves nothing: the results (and the GIF it is not
+    // asked for) keep their bytes and modification times, and no timing of a solve is
+    // printed; only the asked-for frame is drawn anew, and it replaces `png/` as a whole (the
+    // frame of step 0, not drawn this time, is gone; a user's file there stays).
+    std::fs::write(dir.join("png/notes.txt"), "mine").unwrap();
     let results = [
         "summary.json",
         "model.json",
         "steps/0000.json",
         "steps/0001.json",
-        "png/0000.png",
         "anim.gif",
         "vtk/0001.vtu",
         "vtk/paper_square.pvd",
@@ -88,6 +89,24 @@ fn run_png_vtk_then_render_again_with_other_options() {
         assert_eq!(now.1, was.1, "render rewrote {f}");
     }
     assert_eq!(listing(&dir.join("steps")), steps_before);
+    assert_eq!(listing(&dir.join("png")), ["0001.png", "notes.txt"]);
+    assert_eq!(
+        listing(out.path()),
+        ["paper_square"],
+        "no staging folder left"
+    );
+    assert_eq!(
+        listing(&dir),
+        [
+            "anim.gif",
+            "model.json",
+            "png",
+            "steps",
+            "summary.json",
+            "vtk"
+        ],
+        "no staging folder left"
+    );
 
     let o = linkage()
         .arg("render")
@@ -160,4 +179,75 @@ fn bundled_scenes_produce_their_frames_and_gifs() {
         "{}",
         String::from_utf8_lossy(&o.stdout)
     );
+}
+
+/// A run of 10,000 steps or more names its step files, frames and VTK files with enough digits
+/// for its last step, so the names sort in step order, and `linkage render` and the `.pvd`
+/// read them at that width.
+#[test]
+fn file_names_have_enough_digits_for_the_last_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::fs::read_to_string("scenes/paper_square.toml")
+        .unwrap()
+        .replace("steps = 1", "steps = 10000");
+    let here = std::env::current_dir().unwrap().join("scenes");
+    let src = src
+        .replace(
+            "\"square.nodes\"",
+            &format!("{:?}", here.join("square.nodes")),
+        )
+        .replace(
+            "\"square.links\"",
+            &format!("{:?}", here.join("square.links")),
+        );
+    let scene = dir.path().join("long.toml");
+    std::fs::write(&scene, format!("{src}\n[output]\nevery = 4000\n")).unwrap();
+    let out = dir.path().join("out");
+    let o = linkage()
+        .arg("run")
+        .arg(&scene)
+        .args(["--png", "--vtk", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
+    let run = out.join("paper_square");
+    let listing = |d: &str| {
+        let mut names: Vec<String> = std::fs::read_dir(run.join(d))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        names
+    };
+    assert_eq!(
+        listing("steps"),
+        ["00000.json", "04000.json", "08000.json", "10000.json"]
+    );
+    assert_eq!(
+        listing("png"),
+        ["00000.png", "04000.png", "08000.png", "10000.png"]
+    );
+    assert_eq!(
+        listing("vtk"),
+        [
+            "00000.vtu",
+            "04000.vtu",
+            "08000.vtu",
+            "10000.vtu",
+            "paper_square.pvd"
+        ]
+    );
+    let pvd = std::fs::read_to_string(run.join("vtk/paper_square.pvd")).unwrap();
+    assert!(pvd.contains("file=\"04000.vtu\""), "{pvd}");
+    // `linkage render` reads the 5-digit files and names its frames the same way.
+    let o = linkage()
+        .arg("render")
+        .arg(&run)
+        .args(["--width", "64", "--height", "48", "--steps", "4000,10000"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(run.join("png/04000.png").is_file());
+    assert!(run.join("png/10000.png").is_file());
 }

@@ -5,6 +5,8 @@ use crate::render::{
     draw_frame, GifAnimation, RenderError, RenderOptions, RunExtent, StepSelection,
 };
 use crate::scene::atomic_file::write_atomically;
+use crate::scene::publish::{publish_keeping, remove_stale, staging_dir};
+use crate::scene::MIN_STEP_DIGITS;
 use crate::scene::{DrawResults, RunResults, StoredRun, World};
 use std::path::{Path, PathBuf};
 
@@ -89,7 +91,7 @@ pub fn draw_run(
     options.check()?;
     let steps = pick_steps(&run.step_numbers(), dir, &options.steps)?;
     let extent = RunExtent::of_run(run, options.magnification);
-    let mut report = RenderReport {
+    let report = RenderReport {
         steps: steps.clone(),
         magnification: extent.magnification,
         ..RenderReport::default()
@@ -97,13 +99,44 @@ pub fn draw_run(
     if !options.png && !options.gif {
         return Ok(report);
     }
-    let png_dir = dir.join("png");
+    // The frames are drawn into a staging folder that then replaces `png/` as a whole, so
+    // `png/` holds this drawing's frames only (a user's other files in it are kept).
+    let png_dir = staging_dir(dir, "png");
     if options.png {
+        remove_stale(dir, "png");
         std::fs::create_dir_all(&png_dir).map_err(|source| RenderError::Write {
             path: png_dir.clone(),
             source,
         })?;
     }
+    let drawn = draw_frames(run, dir, options, &steps, &extent, &png_dir, report);
+    if png_dir.exists() {
+        let _ = std::fs::remove_dir_all(&png_dir);
+    }
+    drawn
+}
+
+/// Whether `name` is a frame's file name (`NNNN.png`, any number of digits from 4).
+fn is_frame(name: &std::ffi::OsStr) -> bool {
+    name.to_str()
+        .and_then(|n| n.strip_suffix(".png"))
+        .is_some_and(|stem| {
+            stem.len() >= MIN_STEP_DIGITS && stem.bytes().all(|b| b.is_ascii_digit())
+        })
+}
+
+/// The drawing of [`draw_run`]: frames into the staging folder `png_dir`, published as
+/// `dir/png` when all are drawn, and the GIF.
+fn draw_frames(
+    run: &RunResults,
+    dir: &Path,
+    options: &RenderOptions,
+    steps: &[usize],
+    extent: &RunExtent,
+    png_dir: &Path,
+    mut report: RenderReport,
+) -> Result<RenderReport, RenderError> {
+    let final_png = dir.join("png");
     let mut gif = if options.gif {
         Some(GifAnimation::new(options.width, options.height)?)
     } else {
@@ -115,18 +148,25 @@ pub fn draw_run(
             dir: dir.to_path_buf(),
             stored: stored_list(&run.step_numbers()),
         })?;
-        let frame = draw_frame(&run.model, result, &extent, options)?;
+        let frame = draw_frame(&run.model, result, extent, options)?;
         if options.png {
-            let path = png_dir.join(format!("{k:04}.png"));
+            let name = format!("{}.png", run.stem(k));
+            let path = png_dir.join(&name);
             write_atomically(&path, &frame.png()?).map_err(|source| RenderError::Write {
                 path: path.clone(),
                 source,
             })?;
-            report.frames.push(path);
+            report.frames.push(final_png.join(name));
         }
         if let Some(g) = gif.as_mut() {
             g.push(&frame, i + 1 == steps.len())?;
         }
+    }
+    if options.png {
+        publish_keeping(png_dir, &final_png, &is_frame).map_err(|source| RenderError::Write {
+            path: final_png.clone(),
+            source,
+        })?;
     }
     if let Some(g) = gif {
         let path = dir.join("anim.gif");

@@ -4,6 +4,7 @@
 use crate::scene::publish::{destination, publish, remove_stale, staging_dir};
 use crate::scene::results::{PhaseSeconds, Summary};
 use crate::scene::run_error::RunError;
+use crate::scene::run_results::step_digits;
 use crate::scene::simulation::Simulation;
 use crate::scene::writers::{keeps_steps, write_after_steps, write_json, write_step, DrawResults};
 use crate::scene::World;
@@ -82,6 +83,8 @@ fn run_in(
     };
     // The stored steps stay in memory only for the writers after the loop that need them.
     let keep = keeps_steps(world, draw);
+    // Every file name of the run has enough digits for its last step, so they sort.
+    let digits = step_digits(world.steps);
     let mut kept = Vec::new();
     let mut stopped = None;
     for step in 0..=world.steps {
@@ -106,7 +109,7 @@ fn run_in(
         line.seconds = t.elapsed().as_secs_f64() + if step == 1 { setup } else { 0.0 };
         if world.output.writes(step, world.steps) {
             let t = Instant::now();
-            kept.extend(write_step(&steps_dir, &result, keep)?);
+            kept.extend(write_step(&steps_dir, &result, digits, keep)?);
             summary.phases.writing += t.elapsed().as_secs_f64();
         }
         summary.steps.push(line);

@@ -9,7 +9,7 @@ pub use self::results::{
     StepSummary, Summary,
 };
 pub use self::run_error::RunError;
-pub use self::run_results::RunResults;
+pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS};
 pub use self::selector::select_nodes;
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};

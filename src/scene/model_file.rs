@@ -1,7 +1,7 @@
 //! `model.json`: the undeformed model of a run (what the step files do not repeat), written
 //! once per run so results can be drawn and exported again without the scene file.
 
-use crate::contact::obstacle_surface;
+use crate::contact::{obstacle_surface, PatchSurface};
 use crate::scene::results::StepResult;
 use crate::scene::World;
 use crate::Real;
@@ -28,7 +28,9 @@ pub struct ModelBody {
     pub nodes: Vec<Vec<Real>>,
     /// Members as 1-based node pairs, in member order.
     pub members: Vec<[usize; 2]>,
-    /// Outward surface triangles as 1-based node triples (3D; may be empty).
+    /// Surface triangles as 1-based node triples (3D; may be empty): a closed surface outward
+    /// (counter-clockwise seen from outside; given facing in, turned round), an open shell
+    /// as given.
     pub patches: Vec<[usize; 3]>,
     /// Supported nodes, by node number.
     pub supports: Vec<SupportedNode>,
@@ -109,6 +111,15 @@ fn model_obstacles(world: &World) -> Vec<ModelObstacle> {
         .collect()
 }
 
+/// The patches of `body`, a closed surface turned outward as contact sees it
+/// ([`PatchSurface::of`]); an open shell or a surface that is not consistent as given.
+fn outward_patches(body: &crate::linkage::Body) -> Vec<[usize; 3]> {
+    match PatchSurface::of(body) {
+        Ok(Some(surface)) if surface.flipped => surface.patches,
+        _ => body.patches.clone(),
+    }
+}
+
 impl ModelFile {
     /// The undeformed model of `world`.
     pub fn new(world: &World) -> Self {
@@ -148,7 +159,10 @@ impl ModelFile {
                         .iter()
                         .map(|m| [m.nodes[0] + 1, m.nodes[1] + 1])
                         .collect(),
-                    patches: b.patches.iter().map(|p| p.map(|n| n + 1)).collect(),
+                    patches: outward_patches(b)
+                        .iter()
+                        .map(|p| p.map(|n| n + 1))
+                        .collect(),
                     supports,
                 }
             })

@@ -110,10 +110,21 @@ pub fn destination(final_dir: &Path, complete: bool) -> PathBuf {
 /// Safe against another run publishing the same `target` at the same moment: whichever
 /// finishes last is what stays.
 pub fn publish(staging: &Path, target: &Path) -> io::Result<()> {
+    publish_keeping(staging, target, &|name| WRITTEN.iter().any(|w| name == *w))
+}
+
+/// [`publish`] for any folder of `linkage`'s: the entries of the earlier folder for which
+/// `written` is false (not written by `linkage`, so the user's) are moved into the new one
+/// first; the others go with the earlier folder. `linkage render` publishes its `png/` so.
+pub fn publish_keeping(
+    staging: &Path,
+    target: &Path,
+    written: &dyn Fn(&std::ffi::OsStr) -> bool,
+) -> io::Result<()> {
     let mut last = None;
     for _ in 0..ATTEMPTS {
         if target.exists() {
-            keep_foreign_entries(target, staging)?;
+            keep_foreign_entries(target, staging, written)?;
             match exchange(staging, target) {
                 // `staging` now holds the earlier folder.
                 Ok(()) => return std::fs::remove_dir_all(staging),
@@ -140,8 +151,12 @@ fn is_occupied(e: &io::Error) -> bool {
         || e.kind() == io::ErrorKind::DirectoryNotEmpty
 }
 
-/// Move the entries of `from` that `linkage` does not write into `to`.
-fn keep_foreign_entries(from: &Path, to: &Path) -> io::Result<()> {
+/// Move the entries of `from` that `linkage` does not write (`written` is false) into `to`.
+fn keep_foreign_entries(
+    from: &Path,
+    to: &Path,
+    written: &dyn Fn(&std::ffi::OsStr) -> bool,
+) -> io::Result<()> {
     let entries = match std::fs::read_dir(from) {
         Ok(entries) => entries,
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
@@ -150,7 +165,7 @@ fn keep_foreign_entries(from: &Path, to: &Path) -> io::Result<()> {
     for entry in entries {
         let entry = entry?;
         let name = entry.file_name();
-        if WRITTEN.iter().any(|w| name == *w) {
+        if written(&name) {
             continue;
         }
         match std::fs::rename(entry.path(), to.join(&name)) {

@@ -3,7 +3,7 @@
 
 use crate::scene::model_file::ModelFile;
 use crate::scene::results::StepResult;
-use crate::scene::run_results::RunResults;
+use crate::scene::run_results::{step_stem, RunResults, MIN_STEP_DIGITS};
 use std::path::{Path, PathBuf};
 
 /// Why a results folder cannot be read.
@@ -42,10 +42,16 @@ pub struct StoredRun {
     pub model: ModelFile,
     /// Stored step numbers, ascending (step 0 first).
     pub steps: Vec<usize>,
+    /// Digits of the step numbers in the step files' names (the most any has, at least 4):
+    /// pictures and VTK files drawn from the folder are named with as many.
+    pub digits: usize,
+    /// The step files' names, in the order of `steps`.
+    files: Vec<String>,
 }
 
 impl StoredRun {
-    /// Read `dir/model.json` and list `dir/steps/NNNN.json`.
+    /// Read `dir/model.json` and list `dir/steps/NNNN.json` (any number of digits from 4, as
+    /// many as the run's last step needs).
     pub fn open(dir: &Path) -> Result<Self, StoredRunError> {
         let path = dir.join("model.json");
         let bytes = std::fs::read(&path).map_err(|source| StoredRunError::Read {
@@ -70,7 +76,7 @@ impl StoredRun {
             source,
             hint: FOLDER_HINT,
         })?;
-        let mut steps = Vec::new();
+        let mut found: Vec<(usize, String)> = Vec::new();
         for entry in entries {
             let entry = entry.map_err(|source| StoredRunError::Read {
                 path: steps_dir.clone(),
@@ -79,14 +85,28 @@ impl StoredRun {
             })?;
             let name = entry.file_name().to_string_lossy().into_owned();
             if let Some(stem) = name.strip_suffix(".json") {
-                if stem.len() >= 4 && stem.bytes().all(|b| b.is_ascii_digit()) {
+                if stem.len() >= MIN_STEP_DIGITS && stem.bytes().all(|b| b.is_ascii_digit()) {
                     if let Ok(k) = stem.parse::<usize>() {
-                        steps.push(k);
+                        found.push((k, name));
                     }
                 }
             }
         }
-        steps.sort_unstable();
+        found.sort_unstable();
+        if let Some(w) = found.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(StoredRunError::Bad {
+                path: steps_dir,
+                problem: format!(
+                    "holds two files of step {}: {} and {}",
+                    w[0].0, w[0].1, w[1].1
+                ),
+            });
+        }
+        let digits = found
+            .iter()
+            .map(|(_, name)| name.len() - ".json".len())
+            .fold(MIN_STEP_DIGITS, usize::max);
+        let (steps, files): (Vec<usize>, Vec<String>) = found.into_iter().unzip();
         if steps.is_empty() {
             return Err(StoredRunError::Bad {
                 path: steps_dir,
@@ -97,12 +117,19 @@ impl StoredRun {
             dir: dir.to_path_buf(),
             model,
             steps,
+            digits,
+            files,
         })
     }
 
-    /// The file of stored step `step`.
+    /// The file of stored step `step` (as it is named in the folder; a step not stored: the
+    /// name it would have).
     pub fn step_path(&self, step: usize) -> PathBuf {
-        self.dir.join("steps").join(format!("{step:04}.json"))
+        let name = match self.steps.binary_search(&step) {
+            Ok(i) => self.files[i].clone(),
+            Err(_) => format!("{}.json", step_stem(step, self.digits)),
+        };
+        self.dir.join("steps").join(name)
     }
 
     /// Read stored step `step` and check that it matches the model (bodies, nodes, members).
@@ -140,6 +167,7 @@ impl StoredRun {
         Ok(RunResults {
             model: self.model,
             steps,
+            digits: self.digits,
         })
     }
 }

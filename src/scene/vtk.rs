@@ -48,7 +48,8 @@ pub enum VtkError {
 }
 
 /// Write `dir/vtk/NNNN.vtu` for every stored step of `run` and `dir/vtk/<scene>.pvd`, and
-/// with obstacles `dir/vtk/obstacles_NNNN.vtu` (part 1 of the collection); `dir` is the
+/// with obstacles `dir/vtk/obstacles_NNNN.vtu` (part 1 of the collection; `NNNN` padded to
+/// [`RunResults::digits`], as the step files are named); `dir` is the
 /// results folder (`DIR/<scene>`). The collection's `timestep` is the load factor when it
 /// grows strictly over the stored steps, else the step number (ParaView needs increasing
 /// times). Returns the files written.
@@ -63,7 +64,7 @@ pub fn write_vtk(run: &RunResults, dir: &Path) -> Result<Vec<PathBuf>, VtkError>
     let mut entries = Vec::new();
     for result in &run.steps {
         let step = result.step;
-        let name = format!("{step:04}.vtu");
+        let name = format!("{}.vtu", run.stem(step));
         let path = dir.join(&name);
         write_atomically(&path, vtu_text(&run.model.bodies, result).as_bytes()).map_err(
             |source| VtkError::Write {
@@ -83,7 +84,7 @@ pub fn write_vtk(run: &RunResults, dir: &Path) -> Result<Vec<PathBuf>, VtkError>
                     path: results_dir.join("model.json"),
                     problem,
                 })?;
-            let name = format!("obstacles_{step:04}.vtu");
+            let name = format!("obstacles_{}.vtu", run.stem(step));
             let path = dir.join(&name);
             write_atomically(&path, text.as_bytes()).map_err(|source| VtkError::Write {
                 path: path.clone(),

@@ -78,15 +78,29 @@ impl World {
         }
     }
 
-    /// The model's size in one line, as `linkage run` and `linkage check` print it: bodies,
-    /// nodes, members, patches, DOFs and load steps.
+    /// The model's size in one line, as `linkage check` prints it: bodies, nodes, members,
+    /// patches, DOFs and load steps.
     pub fn describe(&self) -> String {
+        self.size_line(None)
+    }
+
+    /// The model's size in one line as `linkage run` prints it: [`World::describe`] with the
+    /// free DOFs (the summary's `free_dofs`, summed over the bodies) after the DOFs, as in
+    /// "1224 DOFs (1152 free)".
+    pub fn describe_solved(&self, free_dofs: usize) -> String {
+        self.size_line(Some(free_dofs))
+    }
+
+    fn size_line(&self, free_dofs: Option<usize>) -> String {
         let nodes: usize = self.bodies.iter().map(|b| b.nodes.len()).sum();
         let members: usize = self.bodies.iter().map(|b| b.members.len()).sum();
         let patches: usize = self.bodies.iter().map(|b| b.patches.len()).sum();
         let dofs: usize = self.bodies.iter().map(|b| b.dof_count()).sum();
+        let free = free_dofs
+            .map(|f| format!(" ({f} free)"))
+            .unwrap_or_default();
         format!(
-            "{} bod{}, {nodes} nodes, {members} members, {patches} patches, {dofs} DOFs, {} step{}",
+            "{} bod{}, {nodes} nodes, {members} members, {patches} patches, {dofs} DOFs{free}, {} step{}",
             self.bodies.len(),
             if self.bodies.len() == 1 { "y" } else { "ies" },
             self.steps,

@@ -5,7 +5,7 @@ use crate::scene::atomic_file::write_atomically;
 use crate::scene::model_file::ModelFile;
 use crate::scene::results::{PhaseSeconds, StepResult};
 use crate::scene::run_error::RunError;
-use crate::scene::run_results::RunResults;
+use crate::scene::run_results::{step_digits, step_stem, RunResults};
 use crate::scene::vtk::write_vtk;
 use crate::scene::World;
 use serde::de::DeserializeOwned;
@@ -66,14 +66,16 @@ fn read_back<T: DeserializeOwned>(path: &Path, bytes: &[u8]) -> Result<T, RunErr
     })
 }
 
-/// Write `steps_dir/NNNN.json` of `result`; with `keep`, return the step as the file gives it
-/// back (see [`read_back`]) for the writers after the loop.
+/// Write `steps_dir/NNNN.json` of `result` (the step number padded to `digits`, see
+/// [`step_digits`]); with `keep`, return the step as the file gives it back (see
+/// [`read_back`]) for the writers after the loop.
 pub(crate) fn write_step(
     steps_dir: &Path,
     result: &StepResult,
+    digits: usize,
     keep: bool,
 ) -> Result<Option<StepResult>, RunError> {
-    let path = steps_dir.join(format!("{:04}.json", result.step));
+    let path = steps_dir.join(format!("{}.json", step_stem(result.step, digits)));
     let bytes = write_json(&path, result, false)?;
     keep.then(|| read_back(&path, &bytes)).transpose()
 }
@@ -98,6 +100,7 @@ pub(crate) fn write_after_steps(
     let run = RunResults {
         model: read_back(&path, &bytes)?,
         steps,
+        digits: step_digits(world.steps),
     };
     if world.pictures.vtk {
         write_vtk(&run, dir).map_err(|e| RunError::Draw {
