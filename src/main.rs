@@ -365,11 +365,21 @@ fn run_scenes(
 fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
     let mut failed = 0;
     for path in scenes {
-        match load_scene(path) {
-            Ok(world) => println!("ok    {}: {}", path.display(), world.describe()),
+        let checked = load_scene(path)
+            .map_err(anyhow::Error::from)
+            .and_then(|world| Ok(linkage::scene::check_world(&world)?));
+        match checked {
+            Ok(report) => print_check(path, &report),
             Err(e) => {
                 failed += 1;
-                println!("FAIL  {e}");
+                // As `linkage run` prints it: errors name their file; prefix the scene when
+                // they name another one.
+                let msg = e.to_string();
+                if msg.starts_with(&path.display().to_string()) {
+                    println!("FAIL  {msg}");
+                } else {
+                    println!("FAIL  {}: {msg}", path.display());
+                }
             }
         }
     }
@@ -381,6 +391,24 @@ fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The report of one scene that passed `linkage check`: its size, per body its sizes and
+/// solver, what only a run can tell, and warnings.
+fn print_check(path: &Path, report: &linkage::scene::CheckReport) {
+    println!("ok    {}: {}", path.display(), report.describe);
+    for b in &report.bodies {
+        println!(
+            "      body '{}': {}D, {} nodes, {} members, {} patches, {} free DOFs, {} solver",
+            b.name, b.dimension, b.nodes, b.members, b.patches, b.free_dofs, b.solver
+        );
+    }
+    for note in &report.notes {
+        println!("      not checked: {note}");
+    }
+    for w in &report.warnings {
+        println!("warn  {}: {w}", path.display());
+    }
 }
 
 fn export(scene: &Path, out: &Path) -> Result<()> {

@@ -66,6 +66,21 @@ pub enum ContactError {
     /// An obstacle could not be built.
     #[error("an obstacle could not be built: {0}")]
     Obstacle(String),
+    /// The bodies of a contact scene are not all 2D or all 3D.
+    #[error("body '{first}' is {first_dimension}D and body '{other}' is {other_dimension}D: the bodies of a scene with contact must all be 2D or all 3D (a 2D body lies in z = 0 and cannot touch a 3D one): give every body the same dimension, or put them in separate scenes")]
+    MixedDimensions {
+        /// The first body.
+        first: String,
+        /// Its dimension (2 or 3).
+        first_dimension: usize,
+        /// The first body of another dimension.
+        other: String,
+        /// Its dimension.
+        other_dimension: usize,
+    },
+    /// A node lies inside an obstacle or another body at step 0, deeper than the tolerance.
+    #[error(transparent)]
+    StartsInside(Box<crate::contact::StartOverlap>),
     /// The result is not finite.
     #[error("step {step}: the solution with contact is not finite: check the penalty ([contact] penalty) and the loads")]
     NotFinite {

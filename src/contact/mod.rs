@@ -10,6 +10,7 @@ pub use self::penalty::{default_penalty, penetration_tolerance, Penalty, PENALTY
 pub use self::report::ContactStep;
 pub use self::settings::ContactSettings;
 pub use self::settle::ContactSolver;
+pub use self::start::StartOverlap;
 pub use self::surface::{cut_by_z0, obstacle_surface, Surface};
 
 mod boundary;
@@ -27,4 +28,5 @@ mod penalty;
 mod report;
 mod settings;
 mod settle;
+mod start;
 mod surface;

@@ -5,6 +5,7 @@ use crate::contact::coupled::CoupledSolver;
 use crate::contact::detect::{candidate_nodes, Geometry};
 use crate::contact::evaluate::{evaluate, Evaluation};
 use crate::contact::report::{finish, ContactStep};
+use crate::contact::start::{no_start_overlap, one_dimension};
 use crate::contact::{
     default_penalty, penetration_tolerance, ActiveContact, ContactError, ContactSet,
     ContactSettings, Obstacle, Penalty,
@@ -189,6 +190,7 @@ impl ContactSolver {
         settings: ContactSettings,
     ) -> Result<Self, ContactError> {
         let t = Instant::now();
+        one_dimension(bodies)?;
         let mut parts = Vec::with_capacity(bodies.len());
         let mut node_offsets = Vec::with_capacity(bodies.len());
         let mut nodes = 0;
@@ -221,6 +223,7 @@ impl ContactSolver {
             ..Default::default()
         };
         let geometry = Geometry::new(bodies, obstacles)?;
+        no_start_overlap(bodies, &parts, &geometry)?;
         let mut condensed = None;
         let mut mechanism = None;
         if settings.condense && bodies.iter().all(|b| !b.is_nonlinear()) {

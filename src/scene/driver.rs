@@ -1,6 +1,7 @@
 //! The load-step driver: step a [`Simulation`] through a world's load steps and hand each
 //! result to the writers, in a staging folder published when complete.
 
+use crate::scene::check::output_warning;
 use crate::scene::publish::{destination, publish, remove_stale, staging_dir};
 use crate::scene::results::{PhaseSeconds, Summary};
 use crate::scene::run_error::RunError;
@@ -107,6 +108,9 @@ fn run_in(
             Err(e) => return Err(e),
         };
         line.seconds = t.elapsed().as_secs_f64() + if step == 1 { setup } else { 0.0 };
+        if step == 0 {
+            line.warnings.extend(output_warning(world));
+        }
         if world.output.writes(step, world.steps) {
             let t = Instant::now();
             kept.extend(write_step(&steps_dir, &result, digits, keep)?);

@@ -1,6 +1,10 @@
 //! Scene files, the load-step driver and the result files.
 
 pub use self::build::{build_world, load_scene, SceneError};
+pub use self::check::{
+    check_world, obstacle_offset_bytes, output_warning, step_file_bytes, stored_steps, CheckReport,
+    BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
+};
 pub use self::driver::{run, run_until, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
@@ -19,6 +23,7 @@ pub use self::writers::DrawResults;
 
 pub mod atomic_file;
 mod build;
+mod check;
 mod driver;
 mod mesh_file;
 mod model_file;
