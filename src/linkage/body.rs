@@ -188,6 +188,18 @@ pub enum BodyError {
         /// Distance between them, m.
         length: Real,
     },
+    /// Coordinates too large to square: lengths overflow.
+    #[error("body '{body}': member {member} joins nodes {a} and {b}, but the coordinates are too large to square (lengths overflow past 1e308): give coordinates in metres, below about 1e150")]
+    TooLarge {
+        /// Body name.
+        body: String,
+        /// The member, 1-based.
+        member: usize,
+        /// First node, 1-based.
+        a: usize,
+        /// Second node, 1-based.
+        b: usize,
+    },
     /// Two members joining the same pair of nodes.
     #[error("body '{body}': member {member} joins nodes {a} and {b}, as member {first} already does: remove one (to stiffen a link, use a material with a larger area)")]
     DuplicateMember {
@@ -341,6 +353,17 @@ impl Body {
                     body: body(),
                     member: i + 1,
                     material: m.material + 1,
+                });
+            }
+        }
+        for (i, m) in self.members.iter().enumerate() {
+            let (material, length) = (&self.materials[m.material], self.member_length(i));
+            let k = material.youngs_modulus * material.area / length;
+            if !(k.is_finite() && k > 0.0) {
+                return Err(BodyError::Material {
+                    body: body(),
+                    material: material.name.clone(),
+                    problem: format!("member {} (nodes {} and {}, length {length:e} m) has the axial stiffness E A / L = {k:e} N/m, which is out of range: check the units of E, A and the coordinates", i + 1, m.nodes[0] + 1, m.nodes[1] + 1),
                 });
             }
         }
@@ -530,6 +553,11 @@ pub enum MemberProblem {
         /// Its length, m.
         length: Real,
     },
+    /// Coordinates so large that squaring them overflows: no length can be computed.
+    TooLarge {
+        /// The member, 0-based (the first one checked, when the body's size overflows).
+        member: usize,
+    },
     /// The same pair as an earlier member.
     Duplicate {
         /// The member, 0-based.
@@ -546,6 +574,7 @@ impl MemberProblem {
             MemberProblem::NodeOutOfRange { member, .. }
             | MemberProblem::SelfMember { member, .. }
             | MemberProblem::ZeroLength { member, .. }
+            | MemberProblem::TooLarge { member }
             | MemberProblem::Duplicate { member, .. } => member,
         }
     }
@@ -572,6 +601,12 @@ impl MemberProblem {
                 a: ends(member)[0],
                 b: ends(member)[1],
                 length,
+            },
+            MemberProblem::TooLarge { member } => BodyError::TooLarge {
+                body,
+                member: member + 1,
+                a: ends(member)[0],
+                b: ends(member)[1],
             },
             MemberProblem::Duplicate { member, first } => BodyError::DuplicateMember {
                 body,
@@ -600,6 +635,9 @@ pub fn check_members(
             return Err(MemberProblem::SelfMember { member: i, node: a });
         }
         let length = (nodes[b] - nodes[a]).norm();
+        if !(length.is_finite() && scale.is_finite()) {
+            return Err(MemberProblem::TooLarge { member: i });
+        }
         if length <= 1e-12 * scale || length == 0.0 {
             return Err(MemberProblem::ZeroLength { member: i, length });
         }

@@ -64,8 +64,8 @@ impl Material {
         }
     }
 
-    /// Why this material cannot be used, if it cannot: E and A must be finite and positive,
-    /// strengths finite and positive when given.
+    /// Why this material cannot be used, if it cannot: E, A and their product E A must be
+    /// finite and positive, strengths finite and positive when given.
     pub fn problem(&self) -> Option<String> {
         let positive = |v: Real| v.is_finite() && v > 0.0;
         if !positive(self.youngs_modulus) {
@@ -78,6 +78,13 @@ impl Material {
             return Some(format!(
                 "area = {} must be a finite positive number of m²",
                 self.area
+            ));
+        }
+        let axial = self.youngs_modulus * self.area;
+        if !positive(axial) {
+            return Some(format!(
+                "youngs_modulus = {:e} times area = {:e} gives E A = {axial:e} N, out of the range that can be computed with (finite and > 0): check the units (Pa and m²)",
+                self.youngs_modulus, self.area
             ));
         }
         for (key, v) in [

@@ -43,9 +43,69 @@ pub enum SceneError {
         /// What is wrong and what to do.
         message: String,
     },
-    /// A problem in one of the paper's files a body reads.
-    #[error(transparent)]
-    PaperFile(#[from] PaperFileError),
+    /// A problem in one of the paper's files a body reads, with the scene line naming the file.
+    #[error("{}:{line}: body '{body}': {source}", .path.display())]
+    PaperFile {
+        /// Scene file.
+        path: PathBuf,
+        /// 1-based line of the key that names the file (`nodes`, `links`, `patches`).
+        line: usize,
+        /// The body reading it.
+        body: String,
+        /// The problem in the file.
+        source: PaperFileError,
+    },
+}
+
+/// The 1-based line of the key a `message` is about, within the table whose span starts at
+/// byte `start` of `text` (its header line, or the top of the file): the key named earliest
+/// in the message (as `` `key` ``, `key =` or `[table.key]`), else the table's first line.
+fn key_line(text: &str, start: usize, message: &str) -> usize {
+    let start = start.min(text.len());
+    let first = text[..start].matches('\n').count() + 1;
+    let mut keys: Vec<(String, usize)> = Vec::new();
+    for (k, raw) in text[start..].lines().enumerate() {
+        let line = raw.trim_start();
+        if line.starts_with('[') {
+            if k == 0 {
+                continue;
+            }
+            break;
+        }
+        if let Some((key, _)) = line.split_once('=') {
+            let key = key.trim().trim_matches('"').to_string();
+            if !key.is_empty() && !key.starts_with('#') {
+                keys.push((key, first + k));
+            }
+        }
+    }
+    keys.iter()
+        .filter_map(|(key, line)| {
+            [
+                format!("`{key}`"),
+                format!("`{key}."),
+                format!("{key} ="),
+                format!(".{key}]"),
+            ]
+            .iter()
+            .filter_map(|p| message.find(p.as_str()))
+            .min()
+            .map(|at| (at, *line))
+        })
+        .min()
+        .map_or(first, |(_, line)| line)
+}
+
+/// Byte offset of the `[output]` header in `text` (0 without one).
+fn output_start(text: &str) -> usize {
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        if line.trim_start().starts_with("[output]") {
+            return offset;
+        }
+        offset += line.len();
+    }
+    0
 }
 
 /// Read, parse and check a scene file.
@@ -66,10 +126,11 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     })?;
     let at = |span: std::ops::Range<usize>, message: String| SceneError::At {
         path: path.to_path_buf(),
-        line: text[..span.start.min(text.len())].matches('\n').count() + 1,
+        line: key_line(text, span.start, &message),
         message,
     };
     let top = 0..0;
+    let output_span = output_start(text)..output_start(text);
     if spec.name.is_empty()
         || spec.name.starts_with('.')
         || !spec
@@ -93,13 +154,19 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     }
     let output = OutputSettings {
         every: match spec.output.every {
-            Some(0) => return Err(at(top, "[output] every = 0: give 1 or more".to_string())),
+            Some(0) => {
+                return Err(at(
+                    output_span,
+                    "[output] every = 0: give 1 or more".to_string(),
+                ))
+            }
             Some(k) => k,
             None => 1,
         },
         last_only: spec.output.last_only,
     };
-    let pictures = PictureSettings::from_spec(&spec.output).map_err(|e| at(top.clone(), e))?;
+    let pictures =
+        PictureSettings::from_spec(&spec.output).map_err(|e| at(output_span.clone(), e))?;
 
     let mut materials = Vec::new();
     for m in &spec.materials {
@@ -121,7 +188,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut bodies: Vec<Body> = Vec::new();
     for b in &spec.bodies {
-        let body = build_body(b, &materials, folder, spec.steps, &at)?;
+        let body = build_body(b, &materials, (text, path), spec.steps, &at)?;
         if bodies.iter().any(|o| o.name == body.name) {
             return Err(at(
                 b.span(),
@@ -172,6 +239,27 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
 }
 
 fn material_from(m: &MaterialSpec) -> Result<Material, String> {
+    if m.name.trim().is_empty() {
+        return Err(
+            "[[materials]] `name` is empty: give the material a name (bodies and links files use it)"
+                .to_string(),
+        );
+    }
+    // Strengths are checked under the key the user wrote.
+    for (key, value) in [
+        ("strength", m.strength),
+        ("tensile_strength", m.tensile_strength),
+        ("compressive_strength", m.compressive_strength),
+    ] {
+        if let Some(v) = value {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!(
+                    "material '{}': {key} = {v} must be a finite positive number of Pa",
+                    m.name
+                ));
+            }
+        }
+    }
     let material = Material {
         name: m.name.clone(),
         youngs_modulus: m.youngs_modulus,
@@ -230,12 +318,39 @@ fn newton_settings(spec: &BodySpec) -> Result<NewtonSettings, String> {
 fn build_body(
     spanned: &Spanned<BodySpec>,
     materials: &[Material],
-    folder: &Path,
+    (text, scene): (&str, &Path),
     steps: usize,
     at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
 ) -> Result<Body, SceneError> {
+    let folder = scene.parent().unwrap_or(Path::new("."));
     let spec = spanned.get_ref();
     let here = |message: String| at(spanned.span(), format!("body '{}': {message}", spec.name));
+    if spec.name.trim().is_empty() {
+        return Err(here(
+            "`name` is empty: give the body a name (results and messages use it)".to_string(),
+        ));
+    }
+    // A paper file the body reads: missing files are reported at the key naming them, problems
+    // inside them with the scene line too.
+    let paper_file = |key: &str, file: &str| -> Result<PathBuf, SceneError> {
+        let full = folder.join(file);
+        if !full.is_file() {
+            return Err(here(format!(
+                "`{key}` = {file:?}: there is no file {}: file names are relative to the folder of the scene file",
+                full.display()
+            )));
+        }
+        Ok(full)
+    };
+    let in_file = |key: &str| {
+        let line = key_line(text, spanned.span().start, &format!("`{key}`"));
+        move |source: PaperFileError| SceneError::PaperFile {
+            path: scene.to_path_buf(),
+            line,
+            body: spec.name.clone(),
+            source,
+        }
+    };
     let kinematics = match spec.kinematics.as_deref() {
         None | Some("linear") => Kinematics::Linear,
         Some("large") => Kinematics::Large,
@@ -332,13 +447,26 @@ fn build_body(
                 "a body read from files needs both `nodes` and `links`".to_string(),
             ));
         };
-        let (dimension, nodes) = paper_files::read_nodes(&folder.join(nodes_file))?;
-        let links = paper_files::read_links(&folder.join(links_file), &nodes)?;
+        let nodes_path = paper_file("nodes", nodes_file)?;
+        let links_path = paper_file("links", links_file)?;
+        let (dimension, nodes) = paper_files::read_nodes(&nodes_path).map_err(in_file("nodes"))?;
+        // Lengths square coordinate differences: past about 1e154 they overflow.
+        if let Some((n, v)) = nodes
+            .iter()
+            .enumerate()
+            .find_map(|(n, p)| p.iter().find(|v| v.abs() > 1e150).map(|v| (n, *v)))
+        {
+            return Err(here(format!(
+                "`nodes` = {nodes_file:?}: node {} has the coordinate {v:e}, too large to square (lengths would overflow): give coordinates in metres, below 1e150",
+                n + 1
+            )));
+        }
+        let links = paper_files::read_links(&links_path, &nodes).map_err(in_file("links"))?;
         for link in &links {
             let material = match &link.material {
                 Some(name) => material_index(name).ok_or_else(|| {
-                    SceneError::PaperFile(PaperFileError::Line {
-                        path: folder.join(links_file),
+                    in_file("links")(PaperFileError::Line {
+                        path: links_path.clone(),
                         line: link.line,
                         message: format!(
                             "material '{name}' is not defined in the scene: add a [[materials]] entry named '{name}'"
@@ -353,7 +481,9 @@ fn build_body(
             });
         }
         if let Some(patches_file) = &spec.patches {
-            body.patches = paper_files::read_patches(&folder.join(patches_file), nodes.len())?;
+            body.patches =
+                paper_files::read_patches(&paper_file("patches", patches_file)?, nodes.len())
+                    .map_err(in_file("patches"))?;
         }
         body.dimension = dimension;
         body.nodes = nodes;
@@ -399,7 +529,7 @@ fn build_body(
         match s {
             None => Ok(Schedule::Linear),
             Some(f) if f.len() != steps => Err(format!(
-                "schedule has {} factors but the scene has {steps} steps: give one factor per step",
+                "`schedule` has {} factors but the scene has {steps} steps: give one factor per step",
                 f.len()
             )),
             Some(f) => Ok(Schedule::Factors(f.clone())),
@@ -466,6 +596,44 @@ fn build_body(
                 ))
             }
         };
+        let key = if lp.force.is_some() {
+            "force"
+        } else {
+            "total_force"
+        };
+        let total = force * nodes.len() as f64;
+        if !(force.norm().is_finite() && total.norm().is_finite()) {
+            return Err(fail(format!(
+                "`{key}` overflows: its magnitude (over {} node{}) is too large to compute with; give forces in N below about 1e150",
+                nodes.len(),
+                if nodes.len() == 1 { "" } else { "s" }
+            )));
+        }
+        // A load in a direction a support fixes goes straight into the reaction. Nodes the user
+        // named must not be loaded so; a line, plane or box may take in a supported node with
+        // the others, but not only such nodes.
+        let held = |node: usize| {
+            body.supports
+                .iter()
+                .filter(|s| s.node == node)
+                .fold([false; 3], |acc, s| [0, 1, 2].map(|k| acc[k] || s.fixed[k]))
+        };
+        let absorbed = |node: usize| (0..d).find(|&k| held(node)[k] && force[k] != 0.0);
+        let named = lp.nodes.is_some() || lp.nearest.is_some();
+        let all_absorbed = nodes
+            .iter()
+            .all(|&n| (0..d).all(|k| force[k] == 0.0 || held(n)[k]));
+        if let Some((node, k)) = nodes
+            .iter()
+            .find_map(|&n| absorbed(n).map(|k| (n, k)))
+            .filter(|_| named || all_absorbed)
+        {
+            return Err(fail(format!(
+                "`{key}` pushes node {} in {}, which a support fixes: that load goes straight into the reaction and moves nothing; remove the node from the load or the direction from the support's `fix`",
+                node + 1,
+                ["x", "y", "z"][k]
+            )));
+        }
         let schedule = schedule(&lp.schedule).map_err(fail)?;
         for node in nodes {
             body.loads.push(NodalLoad {

@@ -21,9 +21,13 @@ pub(crate) fn obstacle_from(
 ) -> Result<Obstacle, String> {
     let name = &spec.name;
     let fail = |m: String| format!("obstacle '{name}': {m}");
-    if name.is_empty() {
-        return Err("an obstacle needs a name".to_string());
+    if name.trim().is_empty() {
+        return Err(
+            "[[obstacles]] `name` is empty: give the obstacle a name (results name it in `with`)"
+                .to_string(),
+        );
     }
+    check_keys_of_shape(spec).map_err(fail)?;
     if bodies.iter().any(|b| &b.name == name) {
         return Err(fail(
             "a body has the same name: obstacles and bodies need distinct names (results name them in `with`)".to_string(),
@@ -137,12 +141,12 @@ pub(crate) fn obstacle_from(
         None => Schedule::Linear,
         Some(f) if f.len() != steps => {
             return Err(fail(format!(
-                "schedule has {} factors but the scene has {steps} steps: give one factor per step",
-                f.len()
-            )))
+            "`schedule` has {} factors but the scene has {steps} steps: give one factor per step",
+            f.len()
+        )))
         }
         Some(f) if f.iter().any(|x| !x.is_finite()) => {
-            return Err(fail("schedule has a non-finite factor".to_string()))
+            return Err(fail("`schedule` has a non-finite factor".to_string()))
         }
         Some(f) => Schedule::Factors(f.clone()),
     };
@@ -152,6 +156,45 @@ pub(crate) fn obstacle_from(
         travel,
         schedule,
     })
+}
+
+/// The shape keys each obstacle shape takes (`travel` and `schedule` go with every shape).
+const SHAPE_KEYS: [(&str, &[&str]); 6] = [
+    ("half_space", &["point", "normal"]),
+    ("cuboid", &["center", "half_extents", "rotation"]),
+    ("ball", &["center", "radius"]),
+    ("cylinder", &["center", "radius", "half_height", "rotation"]),
+    ("capsule", &["center", "radius", "half_height", "rotation"]),
+    ("mesh", &["file"]),
+];
+
+/// A shape key given to a shape that does not take it is an error, not ignored.
+fn check_keys_of_shape(spec: &ObstacleSpec) -> Result<(), String> {
+    let Some((_, takes)) = SHAPE_KEYS.iter().find(|(s, _)| *s == spec.shape) else {
+        return Ok(()); // an unknown shape is reported with the shapes there are
+    };
+    let given = [
+        ("point", spec.point.is_some()),
+        ("normal", spec.normal.is_some()),
+        ("center", spec.center.is_some()),
+        ("half_extents", spec.half_extents.is_some()),
+        ("radius", spec.radius.is_some()),
+        ("half_height", spec.half_height.is_some()),
+        ("rotation", spec.rotation.is_some()),
+        ("file", spec.file.is_some()),
+    ];
+    match given.iter().find(|(key, g)| *g && !takes.contains(key)) {
+        Some((key, _)) => Err(format!(
+            "`{key}` does not apply to a {}, which takes {} (and `travel`, `schedule`): remove it or change `shape`",
+            spec.shape,
+            takes
+                .iter()
+                .map(|k| format!("`{k}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The contact settings of `[contact]` (defaults without it).

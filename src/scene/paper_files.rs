@@ -408,6 +408,10 @@ fn member_error(
             "the member joins nodes {a} and {b}, which are at the same place (length {length:e} m): \
              move one of them in the nodes file, or merge them"
         ),
+        MemberProblem::TooLarge { .. } => format!(
+            "the member joins nodes {a} and {b}, but the coordinates are too large to square \
+             (lengths overflow past 1e308): give coordinates in metres, below about 1e150"
+        ),
         MemberProblem::Duplicate { first, .. } => format!(
             "the member joins nodes {a} and {b}, as line {} already does: remove one of the two lines \
              (to stiffen a link, give it a material with a larger area)",

@@ -37,6 +37,18 @@ pub fn select_nodes(spec: &SelectorSpec, body: &Body) -> Result<Vec<usize>, Stri
         if list.is_empty() {
             return Err("`nodes` is empty: list at least one node number".to_string());
         }
+        if let Some((k, n)) = list
+            .iter()
+            .enumerate()
+            .find(|(k, n)| list[..*k].contains(n))
+        {
+            let first = list.iter().position(|m| m == n).unwrap_or(0);
+            return Err(format!(
+                "`nodes` lists node {n} twice (entries {} and {}): a repeated node would get the load or support twice; list each node once",
+                first + 1,
+                k + 1
+            ));
+        }
         return list
             .iter()
             .map(|&n| {
@@ -44,7 +56,7 @@ pub fn select_nodes(spec: &SelectorSpec, body: &Body) -> Result<Vec<usize>, Stri
                     Ok(n as usize - 1)
                 } else {
                     Err(format!(
-                        "node {n} does not exist: body '{}' has nodes 1 to {count}",
+                        "`nodes` names node {n}, which does not exist: body '{}' has nodes 1 to {count}",
                         body.name
                     ))
                 }
@@ -52,6 +64,15 @@ pub fn select_nodes(spec: &SelectorSpec, body: &Body) -> Result<Vec<usize>, Stri
             .collect();
     }
     let point = |v: &[Real], key: &str| vector(v, body.dimension, key);
+    let key = if spec.nearest.is_some() {
+        "nearest"
+    } else if spec.inside.is_some() {
+        "inside"
+    } else if spec.on_line.is_some() {
+        "on_line"
+    } else {
+        "on_plane"
+    };
     let picked: Vec<usize> = if let Some(p) = &spec.nearest {
         let p = point(p, "nearest")?;
         let best = (0..count).min_by(|&a, &b| {
@@ -95,7 +116,7 @@ pub fn select_nodes(spec: &SelectorSpec, body: &Body) -> Result<Vec<usize>, Stri
     };
     if picked.is_empty() {
         return Err(format!(
-            "the selector matches no node of body '{}' (tolerance {tolerance:e} m): check its coordinates against the body, which spans {}",
+            "the selector `{key}` matches no node of body '{}' (tolerance {tolerance:e} m): check its coordinates against the body, which spans {}",
             body.name,
             extent(body)
         ));

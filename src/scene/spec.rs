@@ -63,7 +63,9 @@ pub struct ObstacleSpec {
     pub radius: Option<Real>,
     /// Half length along the axis (local y) of a cylinder or capsule, m.
     pub half_height: Option<Real>,
-    /// Rotation, degrees: about z in 2D (one number), a rotation vector (axis times angle) in 3D.
+    /// Rotation, degrees: about z in 2D (one number, `45.0` or `[45.0]`), a rotation vector
+    /// (axis times angle) in 3D.
+    #[serde(default, deserialize_with = "number_or_list")]
     pub rotation: Option<Vec<Real>>,
     /// Triangle mesh file of a `"mesh"` obstacle (OBJ, or ASCII or binary STL, m), relative to the scene.
     pub file: Option<String>,
@@ -75,6 +77,37 @@ pub struct ObstacleSpec {
 
 fn one() -> usize {
     1
+}
+
+/// A number or a list of numbers, as a list: `rotation = 45.0` is `[45.0]`.
+fn number_or_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Vec<Real>>, D::Error> {
+    struct Visitor;
+    impl<'de> serde::de::Visitor<'de> for Visitor {
+        type Value = Vec<Real>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a number of degrees or a list of numbers")
+        }
+        fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Self::Value, E> {
+            Ok(vec![v])
+        }
+        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Self::Value, E> {
+            Ok(vec![v as Real])
+        }
+        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Self::Value, E> {
+            Ok(vec![v as Real])
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(
+            self,
+            mut seq: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out = Vec::new();
+            while let Some(x) = seq.next_element::<Real>()? {
+                out.push(x);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_any(Visitor).map(Some)
 }
 
 /// `[[materials]]`: E, A and optional strengths.
