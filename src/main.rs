@@ -285,6 +285,10 @@ fn run_scenes(
             world.pictures.ask_png();
         }
         world.pictures.vtk |= vtk;
+        // Said before the run starts, so a user can stop it before it fills the disk.
+        if let Some(w) = linkage::scene::output_warning(&world) {
+            bar.suspend(|| eprintln!("warn  {}: {w}", world.name));
+        }
         bar.inc_length(world.steps as u64 + 1);
         let summary = run_until(&world, out, &|| bar.inc(1), Some(&PictureWriter), &STOP)?;
         Ok((world, summary, t.elapsed().as_secs_f64()))

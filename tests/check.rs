@@ -160,6 +160,12 @@ fn a_run_that_would_write_more_than_1_gb() {
         .output()
         .unwrap();
     assert!(!run.status.success(), "{}", out(&run));
+    // The run says it before its first step, not only in the summary it ends with.
+    assert!(
+        String::from_utf8_lossy(&run.stderr).contains(&format!("warn  big: {warning}")),
+        "{}",
+        out(&run)
+    );
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(results.join("big/summary.json")).unwrap()).unwrap();
     assert_eq!(summary["steps"][0]["warnings"][0], warning.as_str());

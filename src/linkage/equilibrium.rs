@@ -49,7 +49,7 @@ pub enum SolveError {
     },
     /// A nonlinear step did not converge even with its increment halved `depth` (= the
     /// body's `max_cuts`) times.
-    #[error("body '{body}': step {step} did not converge, even with its load increment halved {depth} times (to 1/{} of the step; {cuts} halvings in this step): {reason}; relative residuals of the last attempt: [{}]. Use more steps (smaller increments), raise [bodies.newton] max_cuts or max_iterations, or follow a limit point with [bodies.path] method = \"arc_length\"", 1u64 << (*.depth).min(63), format_history(.history))]
+    #[error("body '{body}': step {step} did not converge, even with its load increment cut to 1/{} of the step ({depth} halvings deep, the most [bodies.newton] max_cuts allows; {cuts} halvings in this step in all, as the increment grows again after two successes): {reason}; relative residuals of the last attempt: [{}]. Use more steps (smaller increments), raise [bodies.newton] max_cuts or max_iterations, or follow a limit point with [bodies.path] method = \"arc_length\"", 1u64 << (*.depth).min(63), format_history(.history))]
     NotConverged {
         /// Body name.
         body: String,
