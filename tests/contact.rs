@@ -568,6 +568,66 @@ fn mesh_obstacle_matches_the_cuboid() {
     same_answer(&with_mesh[2].0.bodies[0], &with_cuboid[2].0.bodies[0], 1e-9);
 }
 
+/// The cube's OBJ with every face listed clockwise (all facing in), or with one face turned
+/// round, is turned outward as a whole and acts as the outward cube (to 1e-9 of the largest, as
+/// the cuboid does: a reversed quad is fanned along its other diagonal); with a face missing it is refused at loading (so by `check` and `run` alike)
+/// with an edge of the hole.
+#[test]
+fn inward_and_partly_flipped_meshes_are_turned_outward_and_open_ones_refused() {
+    let (_dir, outward) = scene_with(
+        &[("cube.obj", CUBE_OBJ)],
+        &box_on_cube("shape = \"mesh\"\nfile = \"cube.obj\""),
+    );
+    let reference = run_all(&load_scene(&outward).unwrap());
+    let turned = |keep: &dyn Fn(usize) -> bool| -> String {
+        let mut face = 0;
+        CUBE_OBJ
+            .lines()
+            .map(|line| match line.strip_prefix("f ") {
+                Some(rest) => {
+                    face += 1;
+                    if keep(face) {
+                        line.to_string()
+                    } else {
+                        let mut v: Vec<&str> = rest.split_whitespace().collect();
+                        v.reverse();
+                        format!("f {}", v.join(" "))
+                    }
+                }
+                None => line.to_string(),
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    for (name, mesh) in [
+        ("inward", turned(&|_| false)),
+        ("one face flipped", turned(&|f| f != 3)),
+    ] {
+        let (_d, path) = scene_with(
+            &[("cube.obj", &mesh)],
+            &box_on_cube("shape = \"mesh\"\nfile = \"cube.obj\""),
+        );
+        let solved = run_all(&load_scene(&path).unwrap_or_else(|e| panic!("{name}: {e}")));
+        same_answer(&solved[2].0.bodies[0], &reference[2].0.bodies[0], 1e-9);
+    }
+    let open: String = CUBE_OBJ
+        .lines()
+        .filter(|l| *l != "f 5 6 7 8")
+        .collect::<Vec<_>>()
+        .join("\n");
+    let (_d, path) = scene_with(
+        &[("cube.obj", &open)],
+        &box_on_cube("shape = \"mesh\"\nfile = \"cube.obj\""),
+    );
+    let message = load_scene(&path).unwrap_err().to_string();
+    assert!(
+        message.contains("cube.obj")
+            && message.contains("the mesh is open there")
+            && message.contains("watertight"),
+        "{message}"
+    );
+}
+
 /// The cube as a binary STL (whose 80-byte header begins with `solid`, as many exporters write
 /// it: the file's size tells it from ASCII) gives the same answer as the cube as an ASCII STL:
 /// the same 9 contacts, depths, forces and displacements (to 1e-12 of the largest: the corners

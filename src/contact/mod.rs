@@ -3,6 +3,7 @@
 pub use self::boundary::boundary_loop;
 pub use self::contact_set::{ActiveContact, ContactSet, NodeContact, Target};
 pub use self::error::ContactError;
+pub use self::mesh_orientation::{orient_outward, MeshProblem, Orientation};
 pub use self::obstacle::{Obstacle, ObstacleShape};
 pub use self::obstacles::{mesh_collider, primitive_collider, ObstacleProjection, Obstacles};
 pub use self::patch_surface::{PatchSurface, SurfaceProblem};
@@ -21,6 +22,7 @@ mod coupled_system;
 mod detect;
 mod error;
 mod evaluate;
+mod mesh_orientation;
 mod obstacle;
 mod obstacles;
 mod patch_surface;

@@ -1,7 +1,7 @@
 //! Building the scene's rigid obstacles and contact settings from `[[obstacles]]` and
 //! `[contact]`.
 
-use crate::contact::{mesh_collider, ContactSettings, Obstacle, ObstacleShape};
+use crate::contact::{mesh_collider, orient_outward, ContactSettings, Obstacle, ObstacleShape};
 use crate::linkage::{Body, Dimension, Schedule};
 use crate::scene::mesh_file::read_mesh;
 use crate::scene::selector::vector;
@@ -120,7 +120,13 @@ pub(crate) fn obstacle_from(
                         .to_string(),
                 ));
             };
-            let (vertices, triangles) = read_mesh(&folder.join(file))?;
+            let path = folder.join(file);
+            let (vertices, triangles) = read_mesh(&path)?;
+            // Turned outward as a whole (faces that disagree with their neighbours turned too),
+            // as body patches are: contact pushes nodes out along the faces' normals.
+            let triangles = orient_outward(&vertices, &triangles)
+                .map_err(|p| fail(format!("{}: {p}", path.display())))?
+                .triangles;
             let _checked = mesh_collider(&vertices, &triangles).map_err(&fail)?;
             ObstacleShape::Mesh {
                 vertices,
