@@ -23,18 +23,18 @@ fn listing(dir: &Path) -> Vec<String> {
     names
 }
 
+/// The truss scene that solves (5000 N), loaded from `dir` and run once into `out`.
+fn solved_truss(dir: &Path, out: &Path) -> linkage::scene::World {
+    let good = load_scene(&common::truss_scene(dir, "good.toml", "truss", 5000.0)).unwrap();
+    run(&good, out, &|| {}).unwrap();
+    good
+}
+
 #[test]
 fn a_failed_rerun_leaves_the_complete_results_and_puts_its_own_beside_them() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let good = load_scene(&common::truss_scene(
-        dir.path(),
-        "good.toml",
-        "truss",
-        5000.0,
-    ))
-    .unwrap();
-    run(&good, &out, &|| {}).unwrap();
+    let good = solved_truss(dir.path(), &out);
     let complete = out.join("truss");
     let before = std::fs::read(complete.join("steps/0004.json")).unwrap();
 
@@ -76,14 +76,7 @@ fn a_failed_rerun_leaves_the_complete_results_and_puts_its_own_beside_them() {
 fn a_users_files_in_the_results_folder_survive_a_rerun() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let good = load_scene(&common::truss_scene(
-        dir.path(),
-        "good.toml",
-        "truss",
-        5000.0,
-    ))
-    .unwrap();
-    run(&good, &out, &|| {}).unwrap();
+    let good = solved_truss(dir.path(), &out);
     let folder = out.join("truss");
     std::fs::write(folder.join("notes.txt"), "the second design").unwrap();
     std::fs::create_dir(folder.join("plots")).unwrap();
