@@ -3,12 +3,13 @@
 use crate::Real;
 use nalgebra::Vector3;
 
-/// A node held against a surface during one contact iteration.
+/// A node held against a surface during one contact iteration (or, for [`Target::Sharp`], a
+/// point of an obstacle's sharp edge held against a body's surface).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct ActiveContact {
-    /// Body of the node (index in the scene).
+    /// Body of the node (index in the scene); for [`Target::Sharp`], the body pressed.
     pub body: usize,
-    /// The node, 0-based.
+    /// The node, 0-based; for [`Target::Sharp`], the obstacle's sharp point.
     pub node: usize,
     /// What it presses on.
     pub with: Target,
@@ -40,6 +41,15 @@ pub enum Target {
         body: usize,
         /// Position of the vertex in the body's boundary loop.
         vertex: usize,
+    },
+    /// A point along a sharp edge of a polyhedral obstacle (2D: a corner of its section)
+    /// pressing a patch (2D: a boundary segment) of the contact's body: an edge or corner
+    /// between the nodes of a coarse body.
+    Sharp {
+        /// The obstacle (index in the scene).
+        obstacle: usize,
+        /// The patch (3D) or boundary segment (2D) of the body pressed.
+        patch: usize,
     },
 }
 

@@ -1,15 +1,19 @@
 //! Finding contacts: contact candidates, open-shell sides, and the query of every node against the obstacles and the other bodies.
 
 use crate::contact::boundary::{inside_polygon, segment_projection, Surface};
+use crate::contact::obstacle_features::Features;
+use crate::contact::obstacles::to_glam;
 use crate::contact::patch_surface::PatchSurface;
 use crate::contact::settle::{position, BodyPart};
 use crate::contact::{
     penetration_tolerance, ActiveContact, ContactError, ContactSet, Obstacle, Obstacles,
     SurfaceProblem, Target,
 };
-use crate::linkage::Body;
+use crate::linkage::{Body, Dimension};
 use crate::Real;
 use nalgebra::Vector3;
+use rapier3d_f64::parry::query::{PointQueryWithLocation, Ray, RayCast};
+use rapier3d_f64::parry::shape::TriMesh;
 use std::collections::HashMap;
 
 /// A node counts as inside a surface when it is deeper than this fraction of the penetration
@@ -32,6 +36,9 @@ const MARGIN_MEMBERS: Real = 2.0;
 /// A deformed boundary loop and its bounding box `[x_min, y_min, x_max, y_max]`, m.
 type Polygon = (Vec<Vector3<Real>>, [Real; 4]);
 
+/// A closed body's deformed patches as a parry mesh, and its bounding box `[lo, hi]`, m.
+type Mesh = (TriMesh, [Vector3<Real>; 2]);
+
 /// What contacts are found against: the bodies' surfaces, the sides of open shells, and the
 /// obstacles.
 pub(crate) struct Geometry {
@@ -46,6 +53,8 @@ pub(crate) struct Geometry {
     pub(crate) shell_reach: Vec<Real>,
     /// The rigid obstacles, held in rapier.
     pub(crate) obstacles: Obstacles,
+    /// Their sharp features and the crossings of nodes into them.
+    pub(crate) features: Features,
 }
 
 impl Geometry {
@@ -66,6 +75,14 @@ impl Geometry {
                 }
             });
         }
+        let shapes: Vec<_> = obstacles.iter().map(|o| &o.shape).collect();
+        let shortest = bodies
+            .iter()
+            .flat_map(|b| (0..b.members.len()).map(|m| b.member_length(m)))
+            .fold(Real::INFINITY, Real::min);
+        let two_d = bodies.iter().any(|b| b.dimension == Dimension::Two);
+        let start = bodies.iter().map(|b| b.nodes.clone()).collect();
+        let features = Features::new(&shapes, start, shortest, two_d);
         let obstacles = Obstacles::new(obstacles).map_err(ContactError::Obstacle)?;
         let sides = patch_surfaces
             .iter()
@@ -84,7 +101,58 @@ impl Geometry {
             sides,
             shell_reach,
             obstacles,
+            features,
         })
+    }
+
+    /// Commit the obstacle crossings of the contacts `active` solved at the last state (the
+    /// obstacles at `offsets` there, m), and take the nodes' positions there as the start of
+    /// the segments along which the next crossings are found.
+    pub(crate) fn record_crossings(
+        &mut self,
+        bodies: &[Body],
+        parts: &[BodyPart],
+        active: &ContactSet,
+        offsets: Vec<Vector3<Real>>,
+    ) {
+        let start = bodies
+            .iter()
+            .enumerate()
+            .map(|(b, body)| {
+                (0..body.nodes.len())
+                    .map(|n| position(bodies, parts, b, n))
+                    .collect()
+            })
+            .collect();
+        self.features.record(active, start, offsets);
+    }
+
+    /// Where `node` of `body` at `x` stands against obstacle `o` at `offset` (m): depth and
+    /// normal. Inside a polyhedral obstacle (or `held` in contact with it), behind the face
+    /// (edge, corner) it crossed since the last solved state; else (a smooth obstacle, a node
+    /// inside already, or outside) from the nearest point. `None` if the obstacle is not in
+    /// the set.
+    pub(crate) fn against_obstacle(
+        &self,
+        body: usize,
+        node: usize,
+        o: usize,
+        x: &Vector3<Real>,
+        offset: &Vector3<Real>,
+        held: bool,
+    ) -> Option<(Real, Option<Vector3<Real>>)> {
+        let p = self.obstacles.project(o, x, offset)?;
+        // A contact held keeps its crossing when the node comes out (its depth turns negative
+        // along the same normal, and the settle loop lets it go).
+        let crossing = if p.depth > 0.0 || held {
+            self.features.crossing(body, node, o, x, offset)
+        } else {
+            None
+        };
+        match crossing {
+            Some(c) => Some((c.depth(x, offset), Some(c.normal))),
+            None => Some((p.depth, p.normal)),
+        }
     }
 
     /// The name of what a contact touches.
@@ -94,6 +162,7 @@ impl Geometry {
             Target::Segment { body, .. }
             | Target::Vertex { body, .. }
             | Target::Patch { body, .. } => &bodies[body].name,
+            Target::Sharp { obstacle, .. } => self.obstacles.name(obstacle),
         }
     }
 
@@ -186,6 +255,7 @@ impl Geometry {
         let before: HashMap<(usize, usize), Target> = solved
             .contacts
             .iter()
+            .filter(|c| !matches!(c.with, Target::Sharp { .. }))
             .map(|c| ((c.body, c.node), c.with))
             .collect();
         let mut changed = false;
@@ -297,8 +367,8 @@ impl Geometry {
                     }
                 };
                 for (o, offset) in offsets.iter().enumerate() {
-                    if let Some(p) = self.obstacles.project(o, &x, offset) {
-                        consider(Target::Obstacle(o), p.depth);
+                    if let Some((depth, _)) = self.against_obstacle(b, node, o, &x, offset, false) {
+                        consider(Target::Obstacle(o), depth);
                     }
                 }
                 for (other, polygon) in polygons.iter().enumerate() {
@@ -358,8 +428,143 @@ impl Geometry {
                 }
             }
         }
+        let sharp = self.sharp_points_inside(bodies, parts, offsets, &polygons, &meshes, &found);
+        found.extend(sharp);
         ContactSet::new(found)
     }
+}
+
+impl Geometry {
+    /// Every point along a sharp obstacle edge (2D: every corner of an obstacle's section) that
+    /// lies inside a closed body, pressing the patch (2D: boundary segment) it entered through:
+    /// the first one met going back along the obstacle's travel since the last solved state
+    /// (the nearest one when the obstacle has not moved). A sharp feature then presses between
+    /// the nodes of a coarse body. A point within a mean member length of a node of the body
+    /// that is itself inside the same obstacle (in `nodes`) is left out: the body follows the
+    /// obstacle with its own nodes there, and the point would count the same contact twice.
+    fn sharp_points_inside(
+        &self,
+        bodies: &[Body],
+        parts: &[BodyPart],
+        offsets: &[Vector3<Real>],
+        polygons: &[Option<Polygon>],
+        meshes: &[Option<Mesh>],
+        nodes: &[ActiveContact],
+    ) -> Vec<ActiveContact> {
+        let min_depth = min_depth(parts);
+        let mut found = Vec::new();
+        for (o, offset) in offsets.iter().enumerate() {
+            let Some(points) = self.features.points.get(o).filter(|p| !p.is_empty()) else {
+                continue;
+            };
+            let back = self.features.start_offset(o) - offset;
+            for (b, body) in bodies.iter().enumerate() {
+                let reach = 100.0 * penetration_tolerance(body);
+                let held: Vec<Vector3<Real>> = nodes
+                    .iter()
+                    .filter(|c| c.body == b && c.with == Target::Obstacle(o))
+                    .map(|c| position(bodies, parts, b, c.node))
+                    .collect();
+                for (point, q) in points.iter().enumerate() {
+                    let x = q + offset;
+                    if held.iter().any(|h| (h - x).norm() < reach) {
+                        continue;
+                    }
+                    let patch = match (&meshes[b], &self.patch_surfaces[b], &polygons[b]) {
+                        (Some((mesh, bounds)), Some(surface), _) if !surface.is_open() => {
+                            entered_patch(mesh, bounds, &x, &back, min_depth)
+                        }
+                        (None, _, Some(polygon)) => entered_segment(polygon, &x, &back, min_depth),
+                        _ => None,
+                    };
+                    if let Some(patch) = patch {
+                        found.push(ActiveContact {
+                            body: b,
+                            node: point,
+                            with: Target::Sharp { obstacle: o, patch },
+                        });
+                    }
+                }
+            }
+        }
+        found
+    }
+}
+
+/// The patch of the closed `mesh` (bounding box `[lo, hi]`) a point now at `x` inside it (deeper
+/// than `min_depth`, m) entered through coming from the direction `back` (m; zero: the nearest
+/// patch).
+fn entered_patch(
+    mesh: &TriMesh,
+    [lo, hi]: &[Vector3<Real>; 2],
+    x: &Vector3<Real>,
+    back: &Vector3<Real>,
+    min_depth: Real,
+) -> Option<usize> {
+    if (0..3).any(|k| x[k] < lo[k] || x[k] > hi[k]) {
+        return None;
+    }
+    let (nearest, depth) = PatchSurface::inside(mesh, x)?;
+    if depth <= min_depth {
+        return None;
+    }
+    let Some(direction) = back.try_normalize(0.0) else {
+        return Some(nearest);
+    };
+    let ray = Ray::new(to_glam(x), to_glam(&direction));
+    let Some(hit) = mesh.cast_local_ray(&ray, Real::MAX, false) else {
+        return Some(nearest);
+    };
+    // The patch under the hit point (the ray's feature numbering is not the patch's).
+    let (_, (patch, _)) = mesh.project_local_point_and_get_location(ray.point_at(hit), false);
+    Some(patch as usize)
+}
+
+/// The boundary segment of the deformed 2D `polygon` a point now at `x` inside it (deeper than
+/// `min_depth`, m) entered through coming from the direction `back` (m; zero: the nearest).
+fn entered_segment(
+    (points, bounds): &Polygon,
+    x: &Vector3<Real>,
+    back: &Vector3<Real>,
+    min_depth: Real,
+) -> Option<usize> {
+    if x.x < bounds[0]
+        || x.y < bounds[1]
+        || x.x > bounds[2]
+        || x.y > bounds[3]
+        || !inside_polygon(x, points)
+    {
+        return None;
+    }
+    let n = points.len();
+    let segment = |i: usize| (points[i], points[(i + 1) % n]);
+    let (nearest, depth) = (0..n)
+        .map(|i| {
+            let (a, b) = segment(i);
+            (i, segment_projection(x, &a, &b).distance)
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    if depth <= min_depth {
+        return None;
+    }
+    // The first segment met going back: x + s d = a + t (b − a), s > 0, 0 ≤ t ≤ 1.
+    let d = back;
+    let mut first: Option<(usize, Real)> = None;
+    for i in 0..n {
+        let (a, b) = segment(i);
+        let e = b - a;
+        let det = e.x * d.y - e.y * d.x;
+        if det == 0.0 {
+            continue;
+        }
+        let w = a - x;
+        let s = (e.x * w.y - e.y * w.x) / det;
+        let t = (d.x * w.y - d.y * w.x) / det;
+        if s > 0.0 && (0.0..=1.0).contains(&t) && first.is_none_or(|(_, f)| s < f) {
+            first = Some((i, s));
+        }
+    }
+    Some(first.map_or(nearest, |(i, _)| i))
 }
 
 /// What a node at `x` inside the deformed boundary `points` of 2D body `body` presses on, and

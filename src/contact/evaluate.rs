@@ -56,7 +56,11 @@ pub(crate) fn evaluate(
     let mut f: Vec<Vec<Real>> = parts.iter().map(|p| vec![0.0; p.u.len()]).collect();
     let mut list = Vec::with_capacity(set.len());
     for c in &set.contacts {
-        let x = position(bodies, parts, c.body, c.node);
+        // A sharp contact's `node` is the obstacle's point, not a node of the body.
+        let x = match c.with {
+            Target::Sharp { .. } => Vector3::zeros(),
+            _ => position(bodies, parts, c.body, c.node),
+        };
         let touch = match c.with {
             Target::Obstacle(o) => on_obstacle(geometry, parts, c, o, &x, &offsets[o]),
             Target::Patch { body, patch } => on_patch(geometry, bodies, parts, c, body, patch, &x),
@@ -66,6 +70,15 @@ pub(crate) fn evaluate(
             Target::Segment { body, segment } => {
                 on_segment(geometry, bodies, parts, c, body, segment, &x)
             }
+            Target::Sharp { obstacle, patch } => on_sharp(
+                geometry,
+                bodies,
+                parts,
+                c,
+                obstacle,
+                patch,
+                &offsets[obstacle],
+            ),
         };
         let Some(Touch {
             depth,
@@ -119,12 +132,61 @@ fn on_obstacle(
     x: &Vector3<Real>,
     offset: &Vector3<Real>,
 ) -> Option<Touch> {
-    let p = geometry.obstacles.project(o, x, offset)?;
+    let (depth, normal) = geometry.against_obstacle(c.body, c.node, o, x, offset, true)?;
     Some(Touch {
-        depth: p.depth,
-        normal: p.normal,
+        depth,
+        normal,
         nodes: vec![(c.body, c.node, 1.0)],
         penalty: parts[c.body].penalty,
+    })
+}
+
+/// Sharp point `c.node` of obstacle `o` at `offset` (m) against `patch` of `c.body` (a
+/// boundary segment in 2D): as a node of another body pressing it, the force spread over the
+/// patch's corners (the obstacle, rigid, takes the rest).
+fn on_sharp(
+    geometry: &Geometry,
+    bodies: &[Body],
+    parts: &[BodyPart],
+    c: &ActiveContact,
+    o: usize,
+    patch: usize,
+    offset: &Vector3<Real>,
+) -> Option<Touch> {
+    let q = geometry.features.points.get(o)?.get(c.node)? + offset;
+    let body = c.body;
+    let penalty = parts[body].penalty;
+    if let Some(surface) = geometry.patch_surfaces[body].as_ref() {
+        let [a, b, cc] = *surface.patches.get(patch)?;
+        let t = triangle_projection(
+            &q,
+            &position(bodies, parts, body, a),
+            &position(bodies, parts, body, b),
+            &position(bodies, parts, body, cc),
+        );
+        return Some(Touch {
+            depth: t.depth,
+            normal: t.normal,
+            nodes: vec![
+                (body, a, -t.weights[0]),
+                (body, b, -t.weights[1]),
+                (body, cc, -t.weights[2]),
+            ],
+            penalty,
+        });
+    }
+    let surface = geometry.surfaces[body].as_ref()?;
+    let (a, b) = surface.segment(patch);
+    let s = segment_projection(
+        &q,
+        &position(bodies, parts, body, a),
+        &position(bodies, parts, body, b),
+    );
+    Some(Touch {
+        depth: s.depth,
+        normal: s.normal,
+        nodes: vec![(body, a, -(1.0 - s.t)), (body, b, -s.t)],
+        penalty,
     })
 }
 

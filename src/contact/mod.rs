@@ -24,6 +24,7 @@ mod error;
 mod evaluate;
 mod mesh_orientation;
 mod obstacle;
+mod obstacle_features;
 mod obstacles;
 mod patch_surface;
 mod penalty;

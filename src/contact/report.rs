@@ -2,7 +2,7 @@
 
 use crate::contact::evaluate::Evaluation;
 use crate::contact::settle::{BodyPart, Problem};
-use crate::contact::{ContactError, NodeContact};
+use crate::contact::{ContactError, NodeContact, Target};
 use crate::linkage::body_state::{internal_force_vector, member_response_at, norm};
 use crate::linkage::{post_process, StepState};
 use crate::Real;
@@ -50,7 +50,16 @@ pub(crate) fn finish(
             .map_or(Vector3::zeros(), |n| e.penalty.force(e.depth, &n));
         out.max_penetration = out.max_penetration.max(e.depth);
         let part = &parts[e.contact.body];
-        if e.depth > part.tolerance {
+        // An obstacle's sharp point presses the body's surface nodes: all of them touch it.
+        let sharp = matches!(e.contact.with, Target::Sharp { .. });
+        if e.depth > part.tolerance && sharp {
+            out.warnings.push(format!(
+                "step {step}: a sharp edge of '{name}' is {:.3e} m inside body '{}' (tolerance {:.3e} m): raise [contact] penalty",
+                e.depth,
+                bodies[e.contact.body].name,
+                part.tolerance
+            ));
+        } else if e.depth > part.tolerance {
             out.warnings.push(format!(
                 "step {step}: node {} of body '{}' is {:.3e} m inside '{name}' (tolerance {:.3e} m): raise [contact] penalty",
                 e.contact.node + 1,
@@ -61,7 +70,7 @@ pub(crate) fn finish(
         }
         for (k, &(b, node, w)) in e.nodes.iter().enumerate() {
             // The pressing node touches the target; a surface node touches the pressing body.
-            let (with, depth) = if k == 0 {
+            let (with, depth) = if k == 0 || sharp {
                 (name.clone(), e.depth.max(0.0))
             } else {
                 (bodies[e.contact.body].name.clone(), 0.0)

@@ -338,6 +338,10 @@ impl ContactSolver {
         }
         self.geometry
             .record_sides(bodies, &self.parts, &self.active);
+        let last = if restart { 0 } else { self.step };
+        let last_offsets = obstacles.iter().map(|o| o.offset(last, steps)).collect();
+        self.geometry
+            .record_crossings(bodies, &self.parts, &self.active, last_offsets);
         if let Some(c) = self.condensed.as_mut() {
             c.start_step(step, steps, restart);
         }

@@ -64,6 +64,10 @@ pub(crate) fn no_start_overlap(
     let mut deepest: Vec<Option<Deepest>> = vec![None; bodies.len()];
     for e in &evaluated.list {
         let b = e.contact.body;
+        // A sharp obstacle point inside a body has no node to name (its nodes are outside).
+        if matches!(e.contact.with, Target::Sharp { .. }) {
+            continue;
+        }
         if e.depth > parts[b].tolerance && deepest[b].is_none_or(|(_, d, _, _)| e.depth > d) {
             deepest[b] = Some((e.contact.node, e.depth, e.contact.with, e.normal));
         }

@@ -1,0 +1,340 @@
+//! Sharp obstacle features (issue 11, item 1): a node inside a polyhedral obstacle is pushed out
+//! through the face (edge, corner) it crossed, and an obstacle's sharp edge between the nodes of
+//! a coarse body still presses its patches (2D: boundary segments). Each set-up is symmetric:
+//! the answer must be too, on the condensed and the coupled path alike.
+
+use linkage::scene::{load_scene, BodyResult, Simulation, StepResult};
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+/// The last step of the scene `scene` (with `files` beside it), solved condensed (the default)
+/// or coupled (`[contact] condense = false`).
+fn last_step(files: &[(&str, &str)], scene: &str, condense: bool) -> StepResult {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let path: PathBuf = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).unwrap();
+    let mut world = load_scene(&path).unwrap();
+    world.contact.condense = condense;
+    let mut sim = Simulation::new(&world).expect("builds");
+    let mut last = None;
+    for k in 0..=world.steps {
+        last = Some(sim.step(k).expect("solves").0);
+    }
+    last.unwrap()
+}
+
+/// The total contact force the body receives, N.
+fn total(body: &BodyResult) -> [f64; 3] {
+    let mut f = [0.0; 3];
+    for c in &body.contacts {
+        for (k, x) in c.force.iter().enumerate() {
+            f[k] += x;
+        }
+    }
+    f
+}
+
+/// Sideways over vertical (y) of a force.
+fn sideways_ratio(f: &[f64; 3]) -> f64 {
+    (f[0] * f[0] + f[2] * f[2]).sqrt() / f[1].abs()
+}
+
+/// The largest difference between the displacements of the nodes mirrored about the plane
+/// `axis` = `at` (m), relative to the largest displacement.
+fn mirror_error(body: &BodyResult, axis: usize, at: f64) -> f64 {
+    reflection_error(body, &[axis], at)
+}
+
+/// As [`mirror_error`], reflecting every axis of `axes` about `at` (two axes: a half turn).
+fn reflection_error(body: &BodyResult, axes: &[usize], at: f64) -> f64 {
+    let origin: Vec<Vec<f64>> = body
+        .positions
+        .iter()
+        .zip(&body.displacements)
+        .map(|(p, u)| p.iter().zip(u).map(|(p, u)| p - u).collect())
+        .collect();
+    let key = |x: &[f64]| -> Vec<i64> { x.iter().map(|v| (v * 1e7).round() as i64).collect() };
+    let index: HashMap<Vec<i64>, usize> = origin
+        .iter()
+        .enumerate()
+        .map(|(i, x)| (key(x), i))
+        .collect();
+    let largest = body
+        .displacements
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut worst: f64 = 0.0;
+    for (i, x) in origin.iter().enumerate() {
+        let mut m = x.clone();
+        for &axis in axes {
+            m[axis] = 2.0 * at - x[axis];
+        }
+        let j = *index.get(&key(&m)).expect("the lattice is symmetric");
+        for k in 0..x.len() {
+            let sign = if axes.contains(&k) { -1.0 } else { 1.0 };
+            worst = worst.max((body.displacements[i][k] - sign * body.displacements[j][k]).abs());
+        }
+    }
+    worst / largest
+}
+
+/// The largest difference between two runs' displacements, relative to the largest.
+fn paths_differ(a: &BodyResult, b: &BodyResult) -> f64 {
+    let largest = b
+        .displacements
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    a.displacements
+        .iter()
+        .flatten()
+        .zip(b.displacements.iter().flatten())
+        .fold(0.0f64, |m, (u, v)| m.max((u - v).abs()))
+        / largest
+}
+
+/// A triangular prism, ridge down along z at x = `ridge`, y = 0.1 from z = −0.05 to 0.25, its
+/// faces at 45°, 5 cm high.
+fn wedge_obj(ridge: f64) -> String {
+    let (l, r) = (ridge - 0.05, ridge + 0.05);
+    format!(
+        "v {ridge} 0.1 -0.05\nv {l} 0.15 -0.05\nv {r} 0.15 -0.05\n\
+         v {ridge} 0.1 0.25\nv {l} 0.15 0.25\nv {r} 0.15 0.25\n\
+         f 1 2 3\nf 4 6 5\nf 1 4 5 2\nf 1 3 6 4\nf 2 5 6 3\n"
+    )
+}
+
+/// A rubber block 0.2 × 0.1 × 0.2 m of `cells`, fixed at y = 0, pressed by `obstacle` (its keys).
+fn block_scene(cells: [usize; 3], obstacle: &str) -> String {
+    format!(
+        r#"
+name = "sharp"
+steps = 1
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "block"
+box_lattice = {{ size = [0.2, 0.1, 0.2], cells = [{}, {}, {}] }}
+material = "rubber"
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }}
+fix = ["x", "y", "z"]
+[[obstacles]]
+name = "press"
+{obstacle}
+"#,
+        cells[0], cells[1], cells[2]
+    )
+}
+
+const WEDGE: &str = "shape = \"mesh\"\nfile = \"wedge.obj\"\ntravel = [0.0, -0.008, 0.0]";
+
+/// Both paths on one scene: the results, and how far they differ.
+fn both(files: &[(&str, &str)], scene: &str) -> (BodyResult, BodyResult, f64) {
+    let condensed = last_step(files, scene, true).bodies.remove(0);
+    let coupled = last_step(files, scene, false).bodies.remove(0);
+    let differ = paths_differ(&condensed, &coupled);
+    (condensed, coupled, differ)
+}
+
+/// The wedge pressed 8 mm into the block with its ridge over the middle line of nodes: those
+/// nodes crossed the ridge edge and are pushed up along the mean of the two faces' normals, so
+/// the block is pressed straight down (it got as much sideways as down before:
+/// [−1965.9, −1965.9, 0] N), and the answer is mirror-symmetric.
+#[test]
+fn wedge_ridge_over_the_middle_line_presses_straight_down() {
+    let obj = wedge_obj(0.1);
+    let (condensed, coupled, differ) = both(&[("wedge.obj", &obj)], &block_scene([8, 4, 8], WEDGE));
+    for body in [&condensed, &coupled] {
+        let f = total(body);
+        eprintln!(
+            "wedge: force {f:?}, sideways/vertical {:.2e}, mirror {:.2e}",
+            sideways_ratio(&f),
+            mirror_error(body, 0, 0.1)
+        );
+        assert!(f[1] < -100.0, "pressed down: {f:?}");
+        assert!(sideways_ratio(&f) < 1e-6, "{f:?}");
+        assert!(mirror_error(body, 0, 0.1) < 1e-9);
+    }
+    eprintln!("wedge: paths differ by {differ:.2e}");
+    assert!(differ < 1e-7, "condensed and coupled differ by {differ:e}");
+}
+
+/// A plate exactly the size of the block's top face pressed 1 cm down: the rim nodes of the
+/// face started on the plate's edges and moved into its bottom face, not through its side
+/// faces: they are pressed down, never sideways (they got e.g. [0, 0, −4.2] N before).
+#[test]
+fn flush_plate_presses_its_rim_nodes_down() {
+    let plate = "shape = \"cuboid\"\ncenter = [0.1, 0.125, 0.1]\nhalf_extents = [0.1, 0.025, 0.1]\ntravel = [0.0, -0.01, 0.0]";
+    let (condensed, coupled, differ) = both(&[], &block_scene([8, 4, 8], plate));
+    for body in [&condensed, &coupled] {
+        let f = total(body);
+        let (x, z) = (mirror_error(body, 0, 0.1), mirror_error(body, 2, 0.1));
+        eprintln!(
+            "plate: force {f:?}, sideways/vertical {:.2e}, mirror x {x:.2e} z {z:.2e}",
+            sideways_ratio(&f)
+        );
+        assert!(f[1] < -100.0, "{f:?}");
+        assert!(sideways_ratio(&f) < 1e-6, "{f:?}");
+        assert!(x < 1e-9 && z < 1e-9);
+        let mut rim = 0;
+        for c in &body.contacts {
+            // Results number nodes from 1.
+            let (p, u) = (&body.positions[c.node - 1], &body.displacements[c.node - 1]);
+            let o: Vec<f64> = p.iter().zip(u).map(|(p, u)| p - u).collect();
+            // Every contact force of the plate is vertical: no side face was crossed.
+            assert!(
+                c.force[0].abs() + c.force[2].abs() <= 1e-9 * f[1].abs(),
+                "node {} gets {:?}",
+                c.node,
+                c.force
+            );
+            let on_rim = [o[0], o[2]]
+                .iter()
+                .any(|v| v.abs() < 1e-9 || (v - 0.2).abs() < 1e-9);
+            if on_rim && (o[1] - 0.1).abs() < 1e-9 {
+                rim += 1;
+                assert!(
+                    c.force[1] < 0.0,
+                    "rim node {} pressed down: {:?}",
+                    c.node,
+                    c.force
+                );
+            }
+        }
+        // Pressed down, frictionless, the rim slides out from under the plate's edge and is
+        // then free beside it (held by nothing sideways, as it should be).
+        eprintln!("plate: {rim} rim nodes in contact");
+    }
+    eprintln!("plate: paths differ by {differ:.2e}");
+    assert!(differ < 1e-7, "{differ:e}");
+}
+
+/// The wedge's ridge between two node lines of a coarse block (5 cells of 4 cm across, the
+/// ridge mid-cell): no node is inside the wedge (its faces are 2 cm above the ridge at the
+/// nearest nodes, the press is 8 mm), yet the ridge presses the top patches: the block gets a
+/// vertical force of the size a finer block (its node line under the ridge) gets, it is not
+/// pushed sideways, and it is as symmetric as its patches are (under a half turn).
+#[test]
+fn wedge_ridge_between_node_lines_still_presses_a_coarse_block() {
+    let obj = wedge_obj(0.1);
+    let (coarse, coupled, differ) = both(&[("wedge.obj", &obj)], &block_scene([5, 2, 5], WEDGE));
+    let fine = last_step(
+        &[("wedge.obj", &obj)],
+        &block_scene([10, 4, 10], WEDGE),
+        true,
+    )
+    .bodies
+    .remove(0);
+    let ff = total(&fine);
+    for body in [&coarse, &coupled] {
+        let f = total(body);
+        // The patches' diagonals all run one way, so the block with its patches is symmetric
+        // under a half turn about the vertical line x = z = 0.1, not under a mirror in x.
+        let mirror = mirror_error(body, 0, 0.1);
+        let turn = reflection_error(body, &[0, 2], 0.1);
+        eprintln!(
+            "coarse: force {f:?} (finer block {ff:?}), sideways/vertical {:.2e}, mirror {mirror:.2e}, half turn {turn:.2e}",
+            sideways_ratio(&f)
+        );
+        assert!(f[1] < 0.0 && ff[1] < 0.0);
+        // The same size as the finer block's (a line load: the finer lattice is softer).
+        let ratio = f[1] / ff[1];
+        assert!((0.5..4.0).contains(&ratio), "coarse / fine = {ratio}");
+        assert!(sideways_ratio(&f) < 1e-6, "{f:?}");
+        assert!(turn < 1e-9, "{turn}");
+        assert!(
+            body.contacts.iter().all(|c| c.with == "press"),
+            "{:?}",
+            body.contacts
+        );
+    }
+    eprintln!("coarse: paths differ by {differ:.2e}");
+    assert!(differ < 1e-7, "{differ:e}");
+}
+
+/// A 2D rubber block 0.2 × 0.1 m of `cells`, fixed at y = 0, pressed 4 mm by a square of half
+/// side 5 cm turned 45° about z, its lower corner (a cuboid's edge along z) at x = 0.1.
+fn square_on_block(cells: [usize; 2]) -> String {
+    let centre = 0.1 + 0.05 * 2f64.sqrt();
+    format!(
+        r#"
+name = "sharp2d"
+steps = 1
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "block"
+rectangle = {{ width = 0.2, height = 0.1, cells = [{}, {}] }}
+material = "rubber"
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0], normal = [0.0, 1.0] }}
+fix = ["x", "y"]
+[[obstacles]]
+name = "press"
+shape = "cuboid"
+center = [0.1, {centre}]
+half_extents = [0.05, 0.05]
+rotation = 45.0
+travel = [0.0, -0.004]
+"#,
+        cells[0], cells[1]
+    )
+}
+
+/// The corner over the middle node of the 2D block's top (8 cells across): that node crossed
+/// the corner and is pushed straight up; symmetric, both paths alike.
+#[test]
+fn rotated_cuboid_edge_over_a_node_of_a_2d_block_presses_straight_down() {
+    let (condensed, coupled, differ) = both(&[], &square_on_block([8, 4]));
+    for body in [&condensed, &coupled] {
+        let f = total(body);
+        let mirror = mirror_error(body, 0, 0.1);
+        eprintln!(
+            "2D over a node: force {f:?}, sideways/vertical {:.2e}, mirror {mirror:.2e}",
+            sideways_ratio(&f)
+        );
+        assert!(f[1] < -10.0, "{f:?}");
+        assert!(sideways_ratio(&f) < 1e-6, "{f:?}");
+        assert!(mirror < 1e-9, "{mirror}");
+    }
+    eprintln!("2D over a node: paths differ by {differ:.2e}");
+    assert!(differ < 1e-7, "{differ:e}");
+}
+
+/// The corner between two boundary nodes of the 2D block's top (7 cells across, the corner
+/// mid-segment): no node is inside the square, yet its corner presses the segment, shared
+/// equally by its ends, with about the force of the corner over a node.
+#[test]
+fn rotated_cuboid_edge_between_nodes_of_a_2d_block_still_presses() {
+    let over = total(&last_step(&[], &square_on_block([8, 4]), true).bodies[0]);
+    let (condensed, coupled, differ) = both(&[], &square_on_block([7, 4]));
+    for body in [&condensed, &coupled] {
+        let f = total(body);
+        let mirror = mirror_error(body, 0, 0.1);
+        eprintln!(
+            "2D between nodes: force {f:?} (over a node {over:?}), sideways/vertical {:.2e}, mirror {mirror:.2e}",
+            sideways_ratio(&f)
+        );
+        let ratio = f[1] / over[1];
+        assert!((0.3..3.0).contains(&ratio), "between / over = {ratio}");
+        assert!(sideways_ratio(&f) < 1e-6, "{f:?}");
+        assert!(mirror < 1e-9, "{mirror}");
+        assert_eq!(
+            body.contacts.len(),
+            2,
+            "the segment's two ends: {:?}",
+            body.contacts
+        );
+    }
+    eprintln!("2D between nodes: paths differ by {differ:.2e}");
+    assert!(differ < 1e-7, "{differ:e}");
+}
