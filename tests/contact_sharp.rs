@@ -167,54 +167,58 @@ fn wedge_ridge_over_the_middle_line_presses_straight_down() {
     assert!(differ < 1e-7, "condensed and coupled differ by {differ:e}");
 }
 
-/// A plate exactly the size of the block's top face pressed 1 cm down: the rim nodes of the
-/// face started on the plate's edges and moved into its bottom face, not through its side
-/// faces: they are pressed down, never sideways (they got e.g. [0, 0, −4.2] N before).
+/// A plate exactly the size of the block's top face (4 × 4 cells, the 16 rim nodes)
+/// pressed 1 cm down: the rim nodes of the face started on the plate's edges and moved into
+/// its bottom face, not through its side faces: they are pressed down or free, never sideways
+/// (they got e.g. [0, 0, −4.2] N before).
 #[test]
 fn flush_plate_presses_its_rim_nodes_down() {
     let plate = "shape = \"cuboid\"\ncenter = [0.1, 0.125, 0.1]\nhalf_extents = [0.1, 0.025, 0.1]\ntravel = [0.0, -0.01, 0.0]";
-    let (condensed, coupled, differ) = both(&[], &block_scene([8, 4, 8], plate));
-    for body in [&condensed, &coupled] {
-        let f = total(body);
-        let (x, z) = (mirror_error(body, 0, 0.1), mirror_error(body, 2, 0.1));
-        eprintln!(
-            "plate: force {f:?}, sideways/vertical {:.2e}, mirror x {x:.2e} z {z:.2e}",
-            sideways_ratio(&f)
-        );
-        assert!(f[1] < -100.0, "{f:?}");
-        assert!(sideways_ratio(&f) < 1e-6, "{f:?}");
-        assert!(x < 1e-9 && z < 1e-9);
-        let mut rim = 0;
-        for c in &body.contacts {
-            // Results number nodes from 1.
-            let (p, u) = (&body.positions[c.node - 1], &body.displacements[c.node - 1]);
-            let o: Vec<f64> = p.iter().zip(u).map(|(p, u)| p - u).collect();
-            // Every contact force of the plate is vertical: no side face was crossed.
-            assert!(
-                c.force[0].abs() + c.force[2].abs() <= 1e-9 * f[1].abs(),
-                "node {} gets {:?}",
-                c.node,
-                c.force
+    // In one step the rim nodes stay pressed under the plate's edges; in two they slide out
+    // from under it in the first (frictionless) and are free beside it in the second.
+    for steps in [1, 2] {
+        let scene = block_scene([4, 2, 4], plate).replace("steps = 2", &format!("steps = {steps}"));
+        let (condensed, coupled, differ) = both(&[], &scene);
+        for body in [&condensed, &coupled] {
+            let f = total(body);
+            let (x, z) = (mirror_error(body, 0, 0.1), mirror_error(body, 2, 0.1));
+            eprintln!(
+                "plate: force {f:?}, sideways/vertical {:.2e}, mirror x {x:.2e} z {z:.2e}",
+                sideways_ratio(&f)
             );
-            let on_rim = [o[0], o[2]]
-                .iter()
-                .any(|v| v.abs() < 1e-9 || (v - 0.2).abs() < 1e-9);
-            if on_rim && (o[1] - 0.1).abs() < 1e-9 {
-                rim += 1;
+            assert!(f[1] < -100.0, "{f:?}");
+            assert!(sideways_ratio(&f) < 1e-6, "{f:?}");
+            assert!(x < 1e-9 && z < 1e-9);
+            let mut rim = 0;
+            for c in &body.contacts {
+                // Results number nodes from 1.
+                let (p, u) = (&body.positions[c.node - 1], &body.displacements[c.node - 1]);
+                let o: Vec<f64> = p.iter().zip(u).map(|(p, u)| p - u).collect();
+                // Every contact force of the plate is vertical: no side face was crossed.
                 assert!(
-                    c.force[1] < 0.0,
-                    "rim node {} pressed down: {:?}",
+                    c.force[0].abs() + c.force[2].abs() <= 1e-9 * f[1].abs(),
+                    "node {} gets {:?}",
                     c.node,
                     c.force
                 );
+                let on_rim = [o[0], o[2]]
+                    .iter()
+                    .any(|v| v.abs() < 1e-9 || (v - 0.2).abs() < 1e-9);
+                if on_rim && (o[1] - 0.1).abs() < 1e-9 {
+                    rim += 1;
+                    assert!(
+                        c.force[1] < 0.0,
+                        "rim node {} pressed down: {:?}",
+                        c.node,
+                        c.force
+                    );
+                }
             }
+            eprintln!("plate, {steps} steps: {rim} of 16 rim nodes in contact, force {f:?}");
         }
-        // Pressed down, frictionless, the rim slides out from under the plate's edge and is
-        // then free beside it (held by nothing sideways, as it should be).
-        eprintln!("plate: {rim} rim nodes in contact");
+        eprintln!("plate, {steps} steps: paths differ by {differ:.2e}");
+        assert!(differ < 1e-7, "{differ:e}");
     }
-    eprintln!("plate: paths differ by {differ:.2e}");
-    assert!(differ < 1e-7, "{differ:e}");
 }
 
 /// The wedge's ridge between two node lines of a coarse block (5 cells of 4 cm across, the

@@ -29,6 +29,11 @@ pub const KEEP_PATCH: Real = 0.05;
 /// round the shell or the nearest patch changed, and it is not held).
 pub const SHELL_REACH_MEMBERS: Real = 3.0;
 
+/// An obstacle's sharp point within this many mean member lengths of a node of a body that is
+/// itself inside the same obstacle does not press that body's patches (the body follows the
+/// obstacle with its own nodes there; see [`Geometry::query`]).
+pub const SHARP_REACH_MEMBERS: Real = 2.0;
+
 /// Candidates lie within this many mean member lengths of another body's bounding box or of
 /// an obstacle (anywhere along its travel).
 const MARGIN_MEMBERS: Real = 2.0;
@@ -439,8 +444,8 @@ impl Geometry {
     /// lies inside a closed body, pressing the patch (2D: boundary segment) it entered through:
     /// the first one met going back along the obstacle's travel since the last solved state
     /// (the nearest one when the obstacle has not moved). A sharp feature then presses between
-    /// the nodes of a coarse body. A point within a mean member length of a node of the body
-    /// that is itself inside the same obstacle (in `nodes`) is left out: the body follows the
+    /// the nodes of a coarse body. A point within `SHARP_REACH_MEMBERS` mean member lengths of a
+    /// node of the body that is itself inside the same obstacle (in `nodes`) is left out: the body follows the
     /// obstacle with its own nodes there, and the point would count the same contact twice.
     fn sharp_points_inside(
         &self,
@@ -459,7 +464,7 @@ impl Geometry {
             };
             let back = self.features.start_offset(o) - offset;
             for (b, body) in bodies.iter().enumerate() {
-                let reach = 100.0 * penetration_tolerance(body);
+                let reach = SHARP_REACH_MEMBERS * 100.0 * penetration_tolerance(body);
                 let held: Vec<Vector3<Real>> = nodes
                     .iter()
                     .filter(|c| c.body == b && c.with == Target::Obstacle(o))

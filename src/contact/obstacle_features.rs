@@ -266,8 +266,9 @@ pub(crate) struct Features {
     /// Crossings found during the step (the first time each node was found inside), so that a
     /// contact keeps one normal through the step's Newton iterations.
     pending: Mutex<HashMap<(usize, usize, usize), Option<Crossing>>>,
-    /// Faces within this distance of a crossing point meet there, m.
-    tolerance: Real,
+    /// Faces within this distance of a crossing point meet there, and a node this near the
+    /// surface may have crossed it, m.
+    pub(crate) tolerance: Real,
 }
 
 impl Features {
