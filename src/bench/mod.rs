@@ -1,5 +1,6 @@
-//! `linkage bench`: lattice, large-displacement and render benchmarks.
+//! `linkage bench`: lattice, large-displacement, render and file-reading benchmarks.
 
 pub mod large;
 pub mod lattice;
+pub mod read;
 pub mod render;

@@ -25,6 +25,7 @@ pub mod atomic_file;
 mod build;
 mod check;
 mod driver;
+mod link_lines;
 mod mesh_file;
 mod model_file;
 mod obstacles;
