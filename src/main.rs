@@ -152,6 +152,9 @@ struct RenderArgs {
     /// Also write the ParaView files (vtk/NNNN.vtu, vtk/<scene>.pvd).
     #[arg(long)]
     vtk: bool,
+    /// With --vtk: write the arrays as ASCII text instead of compressed binary.
+    #[arg(long, requires = "vtk")]
+    vtk_ascii: bool,
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {
@@ -559,7 +562,7 @@ fn bench(cells: Vec<[usize; 3]>, iterative: bool, jacobi: bool, in_process: bool
 
 fn render(a: &RenderArgs) -> Result<()> {
     use linkage::render::{render_run, RenderOptions};
-    use linkage::scene::{write_vtk, RunResults};
+    use linkage::scene::{write_vtk, RunResults, VtkEncoding};
     // A published results folder always has its summary: without it the folder is not one.
     let summary = a.dir.join("summary.json");
     if !summary.is_file() {
@@ -606,7 +609,12 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     if a.vtk {
         let run = RunResults::read(&a.dir)?;
-        let files = write_vtk(&run, &a.dir)?;
+        let encoding = if a.vtk_ascii {
+            VtkEncoding::Ascii
+        } else {
+            VtkEncoding::Binary
+        };
+        let files = write_vtk(&run, &a.dir, encoding)?;
         println!(
             "wrote {} ParaView files in {}",
             files.len(),

@@ -18,6 +18,7 @@ pub use self::selector::select_nodes;
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
 pub use self::vtk::{write_vtk, VtkError};
+pub use self::vtu_arrays::VtkEncoding;
 pub use self::world::{OutputSettings, World};
 pub use self::writers::DrawResults;
 
@@ -40,5 +41,6 @@ mod simulation;
 pub mod spec;
 mod stored_run;
 mod vtk;
+mod vtu_arrays;
 mod world;
 mod writers;
