@@ -22,6 +22,7 @@ pub use self::world::{OutputSettings, World};
 pub use self::writers::DrawResults;
 
 pub mod atomic_file;
+mod bounds;
 mod build;
 mod check;
 mod driver;
