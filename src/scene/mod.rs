@@ -26,6 +26,7 @@ mod bounds;
 mod build;
 mod check;
 mod driver;
+mod instability;
 mod mesh_file;
 mod model_file;
 mod obstacles;
