@@ -238,8 +238,8 @@ fn check_says_which_mesh_faces_it_turned() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("scene.toml");
     std::fs::write(&scene, box_over_mesh()).unwrap();
-    // Face 2 (the first triangle of `f 5 6 7 8`) and 3 (its second) flipped: one quad listed
-    // clockwise; then the whole cube listed clockwise.
+    // Faces 3 and 4 (the two triangles of `f 5 6 7 8`) flipped: one quad listed clockwise;
+    // then the whole cube listed clockwise.
     let flipped = CUBE_OBJ.replace("f 5 6 7 8", "f 8 7 6 5");
     let inward: String = CUBE_OBJ
         .lines()
@@ -249,7 +249,7 @@ fn check_says_which_mesh_faces_it_turned() {
         })
         .collect();
     for (mesh, expected) in [
-        (&flipped, "2 of the 12 faces of"),
+        (&flipped, "cube.obj disagreed with their neighbours or faced inward and were turned outward: faces 3, 4"),
         (&inward, "all 12 faces of"),
     ] {
         std::fs::write(dir.path().join("cube.obj"), mesh).unwrap();
