@@ -587,13 +587,14 @@ fn ascii_stl_facet_with_two_or_four_vertices_names_its_line() {
         (&["0 0 0", "1 0 0"][..], 2),
         (&["0 0 0", "1 0 0", "0 1 0", "1 1 0"], 4),
     ] {
-        // The bad facet is the second: it starts on line 9 (after `solid` and 7 lines).
+        // The bad facet is the second: it starts on line 9 (after `solid` and 7 lines). The
+        // scene line is that of `file`.
         let text = format!("solid t\n{good}{}endsolid t\n", facet(corners));
         let msg = mesh_error("m.stl", text.as_bytes());
         assert_has(
             &msg,
             &[
-                "obstacle 'm'",
+                "scene.toml:17: obstacle 'm': `file`: ",
                 "m.stl:9:",
                 &format!("has {count} vertices"),
                 "exactly 3",

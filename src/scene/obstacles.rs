@@ -124,11 +124,13 @@ pub(crate) fn obstacle_from(
                 ));
             };
             let path = folder.join(file);
-            let (vertices, triangles) = read_mesh(&path).map_err(&fail)?;
+            // Named with the `file` key, so that the scene line given is that key's.
+            let (vertices, triangles) =
+                read_mesh(&path).map_err(|e| fail(format!("`file`: {e}")))?;
             // Turned outward as a whole (faces that disagree with their neighbours turned too),
             // as body patches are: contact pushes nodes out along the faces' normals.
             let oriented = orient_outward(&vertices, &triangles)
-                .map_err(|p| fail(format!("{}: {p}", path.display())))?;
+                .map_err(|p| fail(format!("`file`: {}: {p}", path.display())))?;
             found = turned_faces(name, &path, &oriented.turned, triangles.len());
             let triangles = oriented.triangles;
             let _checked = mesh_collider(&vertices, &triangles).map_err(&fail)?;
