@@ -118,6 +118,13 @@ impl InstabilityWatch {
 /// schedule that jumps, a support that starts moving or a contact that starts pressing is
 /// not a jump of the body's own).
 fn is_jump(now: &Increment, before: &Increment, size: Real) -> bool {
+    now.displacement > JUMP_FLOOR * size
+        && now.displacement > JUMP_RATIO * driven(now, before) * before.displacement
+}
+
+/// How many times more the body's drive changed in `now` than in `before`: the largest ratio
+/// of the load, prescribed-motion and contact-force changes, at least 1.
+fn driven(now: &Increment, before: &Increment) -> Real {
     let growth = |a: Real, b: Real| {
         if a <= 0.0 {
             0.0
@@ -127,12 +134,10 @@ fn is_jump(now: &Increment, before: &Increment, size: Real) -> bool {
             a / b
         }
     };
-    let driven = growth(now.loads, before.loads)
+    growth(now.loads, before.loads)
         .max(growth(now.supports, before.supports))
         .max(growth(now.contact, before.contact))
-        .max(1.0);
-    now.displacement > JUMP_FLOOR * size
-        && now.displacement > JUMP_RATIO * driven * before.displacement
+        .max(1.0)
 }
 
 fn negative_pivots_warning(body: &Body, step: usize, count: usize) -> String {
@@ -145,12 +150,16 @@ fn negative_pivots_warning(body: &Body, step: usize, count: usize) -> String {
 
 fn jump_warning(body: &Body, step: usize, now: &Increment, before: &Increment) -> String {
     format!(
-        "step {step}: body '{}': the displacements jumped: the largest nodal change is {:.3e} m, {:.0} times the {:.3e} m of step {} under a like change of the loads: the body probably snapped through past a limit point, and the steps around it are not a path it can follow; trace it with [bodies.path] method = \"arc_length\"",
+        "step {step}: body '{}': the displacements jumped: the largest nodal change is {:.3e} m, {:.0} times the {:.3e} m of step {} under {}: the body probably snapped through past a limit point, and the steps around it are not a path it can follow; trace it with [bodies.path] method = \"arc_length\"",
         body.name,
         now.displacement,
         now.displacement / before.displacement.max(Real::MIN_POSITIVE),
         before.displacement,
-        step - 1
+        step - 1,
+        match driven(now, before) {
+            d if d <= 1.0 + 1e-6 => "a like change of the loads".to_string(),
+            d => format!("a change of the loads, prescribed motions or contact forces only {d:.3} times that step's"),
+        }
     )
 }
 
