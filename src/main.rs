@@ -417,6 +417,9 @@ fn print_check(path: &Path, report: &linkage::scene::CheckReport) {
             b.name, b.dimension, b.nodes, b.members, b.patches, b.free_dofs, b.solver
         );
     }
+    for f in &report.found {
+        println!("      found: {f}");
+    }
     for note in &report.notes {
         println!("      not checked: {note}");
     }

@@ -23,9 +23,11 @@ pub use self::world::{OutputSettings, World};
 pub use self::writers::DrawResults;
 
 pub mod atomic_file;
+mod bounds;
 mod build;
 mod check;
 mod driver;
+mod instability;
 mod link_lines;
 mod mesh_file;
 mod model_file;

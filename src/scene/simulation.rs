@@ -3,6 +3,7 @@
 
 use crate::contact::{ContactSolver, NodeContact};
 use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
+use crate::scene::instability::InstabilityWatch;
 use crate::scene::results::{
     BodyResult, BodySize, ContactForce, PairForce, StepResult, StepSummary,
 };
@@ -26,6 +27,8 @@ pub struct Simulation<'w> {
     pub world: &'w World,
     /// The solvers of its bodies.
     pub solver: WorldSolver,
+    /// What the instability warnings remember of the previous step.
+    watch: InstabilityWatch,
 }
 
 impl<'w> Simulation<'w> {
@@ -50,7 +53,11 @@ impl<'w> Simulation<'w> {
                 })?;
             WorldSolver::Bodies(solvers)
         };
-        Ok(Simulation { world, solver })
+        Ok(Simulation {
+            world,
+            solver,
+            watch: InstabilityWatch::default(),
+        })
     }
 
     /// The contact solver, in a scene with contact.
@@ -138,6 +145,10 @@ impl<'w> Simulation<'w> {
             }
             result.bodies.push(written);
         }
+        let warnings = self
+            .watch
+            .warnings(&world.bodies, step, &states, &summary.contact_forces);
+        summary.warnings.extend(warnings);
         Ok((result, summary))
     }
 
