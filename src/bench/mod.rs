@@ -1,5 +1,6 @@
-//! `linkage bench`: lattice, large-displacement and render benchmarks.
+//! `linkage bench`: lattice, large-displacement, contact and render benchmarks.
 
+pub mod contact;
 pub mod large;
 pub mod lattice;
 pub mod render;
