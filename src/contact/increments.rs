@@ -271,3 +271,39 @@ fn cut_to(e: ContactError, step: usize, size: &IncrementSize) -> ContactError {
         history,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failures_newton_can_get_past_by_cutting_are_retried_and_report_the_depth() {
+        let failed = ContactError::NotConverged {
+            step: 3,
+            depth: 0,
+            cuts: 0,
+            reason: "no convergence in 4 Newton iterations".to_string(),
+            history: vec![1e-2, 1e-4],
+        };
+        assert!(retried(&failed));
+        assert!(retried(&ContactError::NotFinite { step: 3 }));
+        assert!(retried(&ContactError::Factorization(
+            CholeskyError::NonPositivePivot { dof: 0 }
+        )));
+        // A body no contact holds is not helped by smaller increments.
+        assert!(!retried(&ContactError::Unsupported {
+            step: 3,
+            body: "bar".to_string(),
+            iterations: 50,
+            contacts: 0,
+        }));
+        let mut size = IncrementSize::default();
+        assert!(size.failed(2) && size.failed(2) && !size.failed(2));
+        let message = cut_to(failed, 3, &size).to_string();
+        assert!(
+            message.starts_with("step 3: equilibrium with contact did not converge, even with its increment cut to 1/4 of the step (2 halvings deep, the most [bodies.newton] max_cuts allows; 2 halvings in this step in all"),
+            "{message}"
+        );
+        assert!(message.contains("no convergence in 4 Newton iterations; relative residuals of the last attempt: [1.0e-2, 1.0e-4]"), "{message}");
+    }
+}

@@ -513,7 +513,8 @@ impl ContactSolver {
             if let Some(done) = done {
                 return Ok(done);
             }
-            // Leave the condensed path: the coupled solve from the full displacements.
+            // Leave the condensed path: the coupled solve from the full displacements (not
+            // `leave_condensed`: `problem` borrows the geometry).
             self.condensed = None;
             let t = Instant::now();
             self.coupled.rebuild(&self.parts)?;
