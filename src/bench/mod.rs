@@ -1,5 +1,6 @@
-//! `linkage bench`: lattice, large-displacement, render and file-reading benchmarks.
+//! `linkage bench`: lattice, large-displacement, contact, render and file-reading benchmarks.
 
+pub mod contact;
 pub mod large;
 pub mod lattice;
 pub mod read;

@@ -83,6 +83,9 @@ impl<'w> Simulation<'w> {
                         source,
                     })?;
                 summary.iterations = solved.newton_iterations;
+                summary.cuts = solved.cuts;
+                summary.negative_pivots = solved.negative_pivots;
+                summary.linear_iterations = solved.linear_iterations;
                 summary.contact_iterations = solved.contact_iterations;
                 summary.max_penetration = solved.max_penetration;
                 summary.warnings = solved.warnings;
@@ -160,7 +163,7 @@ impl<'w> Simulation<'w> {
             .enumerate()
             .map(|(i, b)| {
                 let (free_dofs, solver) = match &self.solver {
-                    WorldSolver::Contact(c) => (c.free_dofs(i), "direct".to_string()),
+                    WorldSolver::Contact(c) => (c.free_dofs(i), c.solver_used(i).to_string()),
                     WorldSolver::Bodies(solvers) => {
                         solvers.get(i).map_or((0, String::new()), |s| {
                             (s.free_dofs(), s.solver_used().to_string())
