@@ -121,6 +121,9 @@ mod tests {
             ..Default::default()
         };
         let e = PictureSettings::from_spec(&spec).unwrap_err();
-        assert!(e.contains("vtk_format = \"xml\"") && e.contains("\"ascii\""), "{e}");
+        assert!(
+            e.contains("vtk_format = \"xml\"") && e.contains("\"ascii\""),
+            "{e}"
+        );
     }
 }
