@@ -1,6 +1,9 @@
 //! The `linkage` command line: thin; it parses arguments and calls the library.
 
+mod bench_cli;
+
 use anyhow::{bail, Context, Result};
+use bench_cli::{bench, bench_contact, bench_large, bench_read, bench_render};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
@@ -90,6 +93,18 @@ enum Command {
         /// With --large: load steps (default 5).
         #[arg(long)]
         steps: Option<usize>,
+        /// Time reading the paper's files (nodes, links, patches) of a box lattice instead
+        /// (default 49x49x49 cells: 125,000 nodes, 1,558,396 members), best of 3.
+        #[arg(long)]
+        read: bool,
+        /// Contact instead: a box lattice on a fixed floor pressed by a ball obstacle (default
+        /// 45x45x45 cells, 1.2M members), solved iteratively (--direct: by the direct solver);
+        /// model size, phases, time per contact step, peak memory.
+        #[arg(long)]
+        contact: bool,
+        /// With --contact: solve the lattice with the direct solver.
+        #[arg(long, requires = "contact")]
+        direct: bool,
         /// Time drawing one frame of a shaded shell instead (see --patches, --size).
         #[arg(long)]
         render: bool,
@@ -148,6 +163,9 @@ struct RenderArgs {
     /// Also write the ParaView files (vtk/NNNN.vtu, vtk/<scene>.pvd).
     #[arg(long)]
     vtk: bool,
+    /// With --vtk: write the arrays as ASCII text instead of compressed binary.
+    #[arg(long, requires = "vtk")]
+    vtk_ascii: bool,
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {
@@ -193,11 +211,21 @@ fn main() -> ExitCode {
         Command::Export { scene, out } => export(&scene, &out),
         Command::Render(args) => render(&args),
         Command::Bench {
+            read: true, cells, ..
+        } => bench_read(cells),
+        Command::Bench {
             render: true,
             patches,
             size,
             ..
         } => bench_render(patches, size),
+        Command::Bench {
+            cells,
+            contact: true,
+            steps,
+            direct,
+            ..
+        } => bench_contact(cells, steps, direct),
         Command::Bench {
             cells,
             large: true,
@@ -407,6 +435,9 @@ fn print_check(path: &Path, report: &linkage::scene::CheckReport) {
             b.name, b.dimension, b.nodes, b.members, b.patches, b.free_dofs, b.solver
         );
     }
+    for f in &report.found {
+        println!("      found: {f}");
+    }
     for note in &report.notes {
         println!("      not checked: {note}");
     }
@@ -449,110 +480,9 @@ fn export(scene: &Path, out: &Path) -> Result<()> {
     Ok(())
 }
 
-fn bench_large(
-    cells: Vec<[usize; 3]>,
-    force: Option<f64>,
-    steps: Option<usize>,
-    iterative: bool,
-    cold: bool,
-) -> Result<()> {
-    use linkage::linkage::{SolverChoice, SolverSettings};
-    let cells = cells.first().copied().unwrap_or([16, 16, 150]);
-    let force = force.unwrap_or(2.5e5);
-    let steps = steps.unwrap_or(5);
-    let mut solver = SolverSettings {
-        choice: if iterative {
-            SolverChoice::Iterative
-        } else {
-            SolverChoice::Direct
-        },
-        ..Default::default()
-    };
-    solver.iterative.warm_start = !cold;
-    let how = match (iterative, cold) {
-        (false, _) => "sparse LLᵀ, METIS order, refactored every iteration",
-        (true, false) => "multigrid conjugate gradients, warm-started",
-        (true, true) => "multigrid conjugate gradients, cold starts",
-    };
-    println!("3D column lattice, bottom clamped, top pushed sideways; large displacements by Newton ({how})");
-    let t = linkage::bench::large::measure_large(cells, force, steps, solver)
-        .map_err(anyhow::Error::msg)?;
-    for s in &t.steps {
-        println!("{}", linkage::bench::large::format_step(s));
-    }
-    println!("{}", linkage::bench::large::format_summary(&t));
-    Ok(())
-}
-
-const DEFAULT_BENCH: [[usize; 3]; 6] = [
-    [10, 10, 10],
-    [20, 20, 20],
-    [20, 20, 40],
-    [30, 30, 30],
-    [40, 40, 40],
-    [43, 43, 43],
-];
-
-fn bench(cells: Vec<[usize; 3]>, iterative: bool, jacobi: bool, in_process: bool) -> Result<()> {
-    let sizes = if cells.is_empty() {
-        DEFAULT_BENCH.to_vec()
-    } else {
-        cells
-    };
-    let what = if iterative && jacobi {
-        "block-Jacobi conjugate gradients to 1e-10"
-    } else if iterative {
-        "smoothed-aggregation multigrid conjugate gradients to 1e-10"
-    } else {
-        "direct sparse Cholesky (METIS order)"
-    };
-    println!("3D box lattices: 26-neighbour cells, bottom face fixed, top face loaded; {what}");
-    if iterative {
-        println!("{}", linkage::bench::lattice::ITERATIVE_HEADER);
-    } else {
-        println!("{}", linkage::bench::lattice::HEADER);
-    }
-    for c in sizes {
-        if in_process && iterative {
-            let t = linkage::bench::lattice::measure_iterative(c, !jacobi)
-                .map_err(anyhow::Error::msg)?;
-            println!("{}", linkage::bench::lattice::format_iterative_row(&t));
-        } else if in_process {
-            let t = linkage::bench::lattice::measure_lattice(c).map_err(anyhow::Error::msg)?;
-            println!("{}", linkage::bench::lattice::format_row(&t));
-        } else {
-            // One child per size, so the peak memory column is that size's own.
-            let exe = std::env::current_exe().context("cannot find the linkage executable")?;
-            let mut args = vec!["bench".to_string(), "--in-process".to_string()];
-            if iterative {
-                args.push("--iterative".to_string());
-            }
-            if jacobi {
-                args.push("--jacobi".to_string());
-            }
-            args.extend(["--cells".to_string(), format!("{}x{}x{}", c[0], c[1], c[2])]);
-            let output = std::process::Command::new(exe)
-                .args(&args)
-                .output()
-                .context("cannot start the benchmark child process")?;
-            if !output.status.success() {
-                bail!(
-                    "benchmark of {c:?} failed: {}",
-                    String::from_utf8_lossy(&output.stderr)
-                );
-            }
-            let text = String::from_utf8_lossy(&output.stdout);
-            if let Some(row) = text.lines().last() {
-                println!("{row}");
-            }
-        }
-    }
-    Ok(())
-}
-
 fn render(a: &RenderArgs) -> Result<()> {
     use linkage::render::{render_run, RenderOptions};
-    use linkage::scene::{write_vtk, RunResults};
+    use linkage::scene::{write_vtk, RunResults, VtkEncoding};
     // A published results folder always has its summary: without it the folder is not one.
     let summary = a.dir.join("summary.json");
     if !summary.is_file() {
@@ -599,31 +529,17 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     if a.vtk {
         let run = RunResults::read(&a.dir)?;
-        let files = write_vtk(&run, &a.dir)?;
+        let encoding = if a.vtk_ascii {
+            VtkEncoding::Ascii
+        } else {
+            VtkEncoding::Binary
+        };
+        let files = write_vtk(&run, &a.dir, encoding)?;
         println!(
             "wrote {} ParaView files in {}",
             files.len(),
             a.dir.join("vtk").display()
         );
     }
-    Ok(())
-}
-
-fn bench_render(patches: usize, size: [u32; 2]) -> Result<()> {
-    let t = linkage::bench::render::render_benchmark(patches, size[0], size[1], 3)
-        .map_err(anyhow::Error::msg)?;
-    println!("Rendering: one frame of a bent cylindrical shell, shaded and stress-coloured (supersampling 2x2), best of 3");
-    println!(
-        "{:>9} {:>9} {:>11} {:>10} {:>10}",
-        "patches", "members", "pixels", "draw s", "PNG s"
-    );
-    println!(
-        "{:>9} {:>9} {:>11} {:>10.3} {:>10.3}",
-        t.patches,
-        t.members,
-        format!("{}x{}", t.size[0], t.size[1]),
-        t.draw,
-        t.png
-    );
     Ok(())
 }

@@ -552,3 +552,317 @@ fn rotation_in_2d_is_one_angle_with_or_without_brackets() {
         &["scene.toml:22", "`rotation` has 2 components"],
     );
 }
+
+// ---------------------------------------------------------------- mesh obstacles
+
+/// A closed unit cube as OBJ text, counter-clockwise seen from outside.
+const CUBE_OBJ: &str = "\
+v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n\
+v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
+/// One ASCII STL facet with `corners` (each `x y z` text).
+fn facet(corners: &[&str]) -> String {
+    let mut s = "facet normal 0 0 1\nouter loop\n".to_string();
+    for c in corners {
+        s += &format!("vertex {c}\n");
+    }
+    s + "endloop\nendfacet\n"
+}
+
+/// The error of a 3D scene whose mesh obstacle reads `file` with `bytes`.
+fn mesh_error(file: &str, bytes: &[u8]) -> String {
+    let c = Case::new();
+    std::fs::write(c.dir.path().join(file), bytes).unwrap();
+    let text = format!(
+        "name = \"t\"\n{MATERIAL}\n[[bodies]]\nname = \"b\"\nbox_lattice = {{ size = [0.2, 0.2, 0.2], cells = [1, 1, 1] }}\noffset = [0.0, 2.0, 0.0]\n[[bodies.supports]]\nnodes = [1]\nfix = [\"x\", \"y\", \"z\"]\n[[obstacles]]\nname = \"m\"\nshape = \"mesh\"\nfile = \"{file}\"\n"
+    );
+    scene_error(&c, &text)
+}
+
+#[test]
+fn ascii_stl_facet_with_two_or_four_vertices_names_its_line() {
+    let good = facet(&["0 0 0", "1 0 0", "0 1 0"]);
+    for (corners, count) in [
+        (&["0 0 0", "1 0 0"][..], 2),
+        (&["0 0 0", "1 0 0", "0 1 0", "1 1 0"], 4),
+    ] {
+        // The bad facet is the second: it starts on line 9 (after `solid` and 7 lines). The
+        // scene line is that of `file`.
+        let text = format!("solid t\n{good}{}endsolid t\n", facet(corners));
+        let msg = mesh_error("m.stl", text.as_bytes());
+        assert_has(
+            &msg,
+            &[
+                "scene.toml:17: obstacle 'm': `file`: ",
+                "m.stl:9:",
+                &format!("has {count} vertices"),
+                "exactly 3",
+            ],
+        );
+    }
+    // A facet cut short at the end of the file.
+    let msg = mesh_error(
+        "m.stl",
+        format!("solid t\n{good}facet normal 0 0 1\nouter loop\nvertex 0 0 0\n").as_bytes(),
+    );
+    assert_has(&msg, &["m.stl:9:", "not closed by `endfacet`"]);
+}
+
+#[test]
+fn obj_vertex_with_two_or_four_coordinates_or_a_word_names_its_line() {
+    for (line, expect) in [
+        ("v 1 2", "a vertex has 2 numbers"),
+        ("v 1 2 3 1", "a vertex has 4 numbers"),
+        ("v 1 two 3", "\"two\" is not a number"),
+    ] {
+        let text = CUBE_OBJ.replacen("v 0.5 -0.5 -0.5", line, 1);
+        assert_has(
+            &mesh_error("m.obj", text.as_bytes()),
+            &["obstacle 'm'", "m.obj:2:", expect],
+        );
+    }
+}
+
+#[test]
+fn extra_tokens_in_an_ascii_stl_name_their_line() {
+    let good = facet(&["0 0 0", "1 0 0", "0 1 0"]);
+    for (from, to, line) in [
+        ("vertex 1 0 0", "vertex 1 0 0 7", 5),
+        ("facet normal 0 0 1", "facet normal 0 0 1 0", 2),
+        ("endloop", "endloop now", 7),
+        ("outer loop", "outer", 3),
+    ] {
+        let text = format!("solid t\n{}endsolid t\n", good.replacen(from, to, 1));
+        let msg = mesh_error("m.stl", text.as_bytes());
+        assert_has(&msg, &[&format!("m.stl:{line}:"), "words: write it as"]);
+    }
+    // A line out of place.
+    let text = format!(
+        "solid t\n{}endsolid t\n",
+        good.replacen("outer loop\n", "", 1)
+    );
+    assert_has(
+        &mesh_error("m.stl", text.as_bytes()),
+        &["m.stl:3:", "`vertex` is out of place", "`outer loop`"],
+    );
+}
+
+#[test]
+fn nan_and_inf_coordinates_name_their_line() {
+    for word in ["nan", "inf", "-inf", "NaN"] {
+        let obj = CUBE_OBJ.replacen("v 0.5 0.5 -0.5", &format!("v 0.5 {word} -0.5"), 1);
+        assert_has(
+            &mesh_error("m.obj", obj.as_bytes()),
+            &["m.obj:3:", "not a finite number"],
+        );
+        let stl = format!(
+            "solid t\n{}endsolid t\n",
+            facet(&["0 0 0", &format!("1 {word} 0"), "0 1 0"])
+        );
+        assert_has(
+            &mesh_error("m.stl", stl.as_bytes()),
+            &["m.stl:5:", "not a finite number"],
+        );
+    }
+    // Finite but too large to compute with.
+    let obj = CUBE_OBJ.replacen("v 0.5 0.5 -0.5", "v 0.5 1e200 -0.5", 1);
+    assert_has(
+        &mesh_error("m.obj", obj.as_bytes()),
+        &["m.obj:3:", "1e200", "beyond ±1e100 m"],
+    );
+}
+
+/// A binary STL of `triangles` (corners in m).
+fn binary_stl(triangles: &[[[f32; 3]; 3]]) -> Vec<u8> {
+    let mut out = vec![b' '; 80];
+    out.extend((triangles.len() as u32).to_le_bytes());
+    for t in triangles {
+        out.extend([0u8; 12]);
+        for c in t {
+            for x in c {
+                out.extend(x.to_le_bytes());
+            }
+        }
+        out.extend([0u8; 2]);
+    }
+    out
+}
+
+#[test]
+fn binary_stl_with_nan_or_a_degenerate_triangle_names_the_triangle() {
+    let mut t = [
+        [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    ];
+    t[1][1][2] = f32::NAN;
+    assert_has(
+        &mesh_error("m.stl", &binary_stl(&t)),
+        &[
+            "obstacle 'm'",
+            "m.stl",
+            "triangle 2 (of 2), corner 2",
+            "not finite",
+        ],
+    );
+    t[1] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+    assert_has(
+        &mesh_error("m.stl", &binary_stl(&t)),
+        &["triangle 2 (of 2)", "zero area"],
+    );
+    assert_has(
+        &mesh_error("m.stl", &binary_stl(&[])),
+        &["m.stl", "no triangles"],
+    );
+}
+
+#[test]
+fn face_naming_vertex_zero_or_one_not_defined_names_its_line() {
+    for (face, expect) in [
+        ("f 0 4 3 2", "vertex 0: OBJ vertex numbers start at 1"),
+        (
+            "f 1 4 3 9",
+            "face names vertex 9, but only 8 are defined above it",
+        ),
+        ("f 1 -9 3", "face names vertex -9"),
+        ("f 1 4", "a face has 2 vertices"),
+        ("f 1 4 x", "\"x\" is not a vertex number"),
+    ] {
+        let text = CUBE_OBJ.replacen("f 1 4 3 2", face, 1);
+        assert_has(&mesh_error("m.obj", text.as_bytes()), &["m.obj:9:", expect]);
+    }
+}
+
+#[test]
+fn zero_area_triangle_names_its_line() {
+    // A repeated corner, and corners on one line (vertex 9 midway between 1 and 2).
+    let text = CUBE_OBJ.replacen("f 1 4 3 2", "f 1 4 3 2\nf 1 1 2", 1);
+    assert_has(
+        &mesh_error("m.obj", text.as_bytes()),
+        &["m.obj:10:", "repeats a corner", "zero-area"],
+    );
+    let text = format!("{CUBE_OBJ}v 0 -0.5 -0.5\nf 1 2 9\n");
+    assert_has(
+        &mesh_error("m.obj", text.as_bytes()),
+        &["m.obj:16:", "zero area", "lie on one line"],
+    );
+}
+
+#[test]
+fn empty_mesh_is_an_error() {
+    assert_has(
+        &mesh_error("m.obj", b"# nothing\nv 0 0 0\n"),
+        &["m.obj", "no triangles"],
+    );
+    assert_has(&mesh_error("m.obj", b""), &["m.obj", "no triangles"]);
+    assert_has(
+        &mesh_error("m.stl", b"solid t\nendsolid t\n"),
+        &["m.stl", "no triangles"],
+    );
+}
+
+// ---------------------------------------------------------------- overflowing geometry
+
+/// The error of the square scene with `obstacle` (the keys after `name`), and its line.
+fn obstacle_error(obstacle: &str) -> (String, String) {
+    let c = Case::new();
+    let text = square_text(&format!("[[obstacles]]\nname = \"o\"\n{obstacle}\n"));
+    (scene_error(&c, &text), text)
+}
+
+/// The 1-based line of `text` that starts with `start`.
+fn line_of(text: &str, start: &str) -> usize {
+    text.lines().position(|l| l.starts_with(start)).unwrap() + 1
+}
+
+#[test]
+fn ball_of_radius_1e155_is_an_input_error() {
+    let (msg, text) = obstacle_error("shape = \"ball\"\ncenter = [0.5, -3.0]\nradius = 1e155");
+    let line = line_of(&text, "radius");
+    assert_has(
+        &msg,
+        &[
+            &format!("scene.toml:{line}:"),
+            "obstacle 'o'",
+            "`radius` = 1e155 m",
+            "beyond ±1e100 m",
+            "give lengths in metres",
+        ],
+    );
+    // A centre far away too.
+    let (msg, text) = obstacle_error("shape = \"ball\"\ncenter = [0.5, -1e200]\nradius = 1.0");
+    assert_has(
+        &msg,
+        &[
+            &format!("scene.toml:{}:", line_of(&text, "center")),
+            "`center`",
+            "beyond",
+        ],
+    );
+}
+
+#[test]
+fn rotation_of_1e308_degrees_is_an_input_error() {
+    let (msg, text) = obstacle_error(
+        "shape = \"cuboid\"\ncenter = [0.5, -3.0]\nhalf_extents = [1.0, 1.0]\nrotation = 1e308",
+    );
+    assert_has(
+        &msg,
+        &[
+            &format!("scene.toml:{}:", line_of(&text, "rotation")),
+            "obstacle 'o'",
+            "1e308 degrees",
+            "within ±1e6",
+            "modulo 360",
+        ],
+    );
+    // Up to the bound it is an angle like any other.
+    let c = Case::new();
+    let text = square_text("[[obstacles]]\nname = \"o\"\nshape = \"cuboid\"\ncenter = [0.5, -3.0]\nhalf_extents = [1.0, 1.0]\nrotation = 720.5\n");
+    std::fs::write(c.dir.path().join("scene.toml"), text).unwrap();
+    assert!(load_scene(&c.dir.path().join("scene.toml")).is_ok());
+}
+
+#[test]
+fn travel_of_1e308_is_an_input_error() {
+    let (msg, text) = obstacle_error(
+        "shape = \"half_space\"\npoint = [0.0, -1.0]\nnormal = [0.0, 1.0]\ntravel = [0.0, 1e308]",
+    );
+    assert_has(
+        &msg,
+        &[
+            &format!("scene.toml:{}:", line_of(&text, "travel")),
+            "obstacle 'o'",
+            "`travel`",
+            "beyond ±1e100 m",
+        ],
+    );
+    // A travel within bounds whose schedule multiplies it past them.
+    let (msg, _) = obstacle_error(
+        "shape = \"half_space\"\npoint = [0.0, -1.0]\nnormal = [0.0, 1.0]\ntravel = [0.0, 1e90]\nschedule = [1e20]",
+    );
+    assert_has(&msg, &["`travel`", "largest `schedule` factor"]);
+}
+
+#[test]
+fn huge_generated_or_offset_bodies_are_input_errors() {
+    let c = Case::new();
+    let body = |geometry: &str| {
+        format!(
+        "name = \"t\"\n{MATERIAL}\n[[bodies]]\nname = \"g\"\n{geometry}\n[[bodies.supports]]\nnodes = [1]\nfix = [\"x\", \"y\"]\n"
+    )
+    };
+    let msg = scene_error(
+        &c,
+        &body("rectangle = { width = 1e155, height = 1.0, cells = [1, 1] }"),
+    );
+    assert_has(
+        &msg,
+        &["body 'g'", "`rectangle` places node", "too large to square"],
+    );
+    let msg = scene_error(&c, &body("disk = { radius = 1.0 }\noffset = [1e200, 0.0]"));
+    assert_has(
+        &msg,
+        &["scene.toml:", "body 'g'", "`offset`", "beyond ±1e100 m"],
+    );
+}

@@ -53,6 +53,11 @@ fn both_reject(text: &str, files: &[(&str, &str)], expected: &[&str]) {
     assert!(!run.status.success(), "run passed: {}", out(&run));
     let (c, r) = (fail_line(&check), fail_line(&run));
     assert_eq!(c, r, "check and run differ");
+    // Refused before anything is solved: no results, not even a partial folder.
+    let written: Vec<_> = std::fs::read_dir(dir.path().join("out"))
+        .map(|d| d.filter_map(|e| e.ok()).map(|e| e.path()).collect())
+        .unwrap_or_default();
+    assert!(written.is_empty(), "the run wrote {written:?}");
     for e in expected {
         assert!(c.contains(e), "{e:?} not in {c}");
     }
@@ -199,4 +204,90 @@ fn bundled_scenes_pass_the_check() {
         "{stdout}"
     );
     assert!(!stdout.contains("warn"), "{stdout}");
+}
+
+/// A closed unit cube (OBJ, counter-clockwise seen from outside) and a box lattice above it.
+const CUBE_OBJ: &str = "\
+v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\n\
+v -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\nv 0.5 0.5 0.5\nv -0.5 0.5 0.5\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
+fn box_over_mesh() -> String {
+    format!("name = \"m\"\nsteps = 1\n{STEEL}[[bodies]]\nname = \"block\"\nbox_lattice = {{ size = [0.1, 0.1, 0.1], cells = [1, 1, 1] }}\nmaterial = \"steel\"\noffset = [0.0, 1.0, 0.0]\n[[bodies.supports]]\nnodes = [1, 2, 3, 4, 5, 6, 7, 8]\nfix = [\"x\", \"y\", \"z\"]\n[[obstacles]]\nname = \"cube\"\nshape = \"mesh\"\nfile = \"cube.obj\"\n")
+}
+
+#[test]
+fn an_open_mesh_is_refused_naming_an_edge() {
+    // The top face (y = 0.5, two triangles) left out.
+    let open = CUBE_OBJ.replace("f 3 4 8 7\n", "");
+    both_reject(
+        &box_over_mesh(),
+        &[("cube.obj", &open)],
+        &[
+            "obstacle 'cube'",
+            "cube.obj",
+            "the edge from vertex",
+            "the mesh is open there",
+            "add the missing faces",
+        ],
+    );
+}
+
+#[test]
+fn check_says_which_mesh_faces_it_turned() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, box_over_mesh()).unwrap();
+    // Faces 3 and 4 (the two triangles of `f 5 6 7 8`) flipped: one quad listed clockwise;
+    // then the whole cube listed clockwise.
+    let flipped = CUBE_OBJ.replace("f 5 6 7 8", "f 8 7 6 5");
+    let inward: String = CUBE_OBJ
+        .lines()
+        .map(|l| match l.strip_prefix("f ") {
+            Some(f) => format!("f {}\n", f.split(' ').rev().collect::<Vec<_>>().join(" ")),
+            None => format!("{l}\n"),
+        })
+        .collect();
+    for (mesh, expected) in [
+        (&flipped, "cube.obj disagreed with their neighbours or faced inward and were turned outward: faces 3, 4"),
+        (&inward, "all 12 faces of"),
+    ] {
+        std::fs::write(dir.path().join("cube.obj"), mesh).unwrap();
+        let check = linkage().arg("check").arg(&scene).output().unwrap();
+        assert!(check.status.success(), "{}", out(&check));
+        let text = out(&check);
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("found: obstacle 'cube'"))
+            .unwrap_or_else(|| panic!("no found line: {text}"));
+        assert!(
+            line.contains(expected) && line.contains("turned outward"),
+            "{line}"
+        );
+    }
+    // An outward cube: nothing to say.
+    std::fs::write(dir.path().join("cube.obj"), CUBE_OBJ).unwrap();
+    let check = linkage().arg("check").arg(&scene).output().unwrap();
+    assert!(!out(&check).contains("found:"), "{}", out(&check));
+}
+
+#[test]
+fn overflowing_geometry_is_refused_before_anything_is_written() {
+    let disk = format!("name = \"g\"\nsteps = 1\n{STEEL}[[bodies]]\nname = \"disk\"\ndisk = {{ radius = 0.1 }}\nmaterial = \"steel\"\n[[bodies.supports]]\nnodes = [1]\nfix = [\"x\", \"y\"]\n[[obstacles]]\nname = \"o\"\n");
+    for (obstacle, key, expected) in [
+        ("shape = \"ball\"\ncenter = [0.0, -5.0]\nradius = 1e155\n", "radius", "`radius` = 1e155 m"),
+        ("shape = \"cuboid\"\ncenter = [0.0, -5.0]\nhalf_extents = [1.0, 1.0]\nrotation = 1e308\n", "rotation", "1e308 degrees"),
+        ("shape = \"half_space\"\npoint = [0.0, -1.0]\nnormal = [0.0, 1.0]\ntravel = [0.0, 1e308]\n", "travel", "`travel` = 1e308 m"),
+    ] {
+        let text = format!("{disk}{obstacle}");
+        let line = text.lines().position(|l| l.starts_with(key)).unwrap() + 1;
+        both_reject(&text, &[], &[&format!("scene.toml:{line}:"), "obstacle 'o'", expected]);
+    }
+    // NaN in a mesh.
+    let nan = CUBE_OBJ.replace("v 0.5 0.5 0.5", "v 0.5 nan 0.5");
+    both_reject(
+        &box_over_mesh(),
+        &[("cube.obj", &nan)],
+        &["cube.obj:7:", "\"nan\" is not a finite number"],
+    );
 }

@@ -684,3 +684,157 @@ fn unloading_returns_to_the_undeformed_state() {
         assert!((a - b).norm() <= 1e-6 * scale);
     }
 }
+
+// ---------------------------------------------------------------- instability warnings
+
+/// The bundled von Mises truss under load control in `dir/vm.toml`: `steps` steps to `factor`
+/// times its limit load (7622 N) at the apex, following `schedule` when given, with the
+/// `[bodies.path]` lines `path`.
+fn von_mises_scene(
+    dir: &std::path::Path,
+    steps: usize,
+    factor: f64,
+    schedule: Option<&[f64]>,
+    path: &str,
+) -> std::path::PathBuf {
+    let here = std::env::current_dir().unwrap().join("scenes");
+    let schedule = schedule.map_or(String::new(), |s| format!("schedule = {s:?}\n"));
+    let scene = dir.join("vm.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "name = \"vm\"\nsteps = {steps}\n[[materials]]\nname = \"steel\"\nyoungs_modulus = 200e9\narea = 1e-4\n\
+             [[bodies]]\nname = \"truss\"\nnodes = \"{}\"\nlinks = \"{}\"\nkinematics = \"large\"\n{path}\n\
+             [[bodies.supports]]\nnodes = [1, 3]\nfix = [\"x\", \"y\"]\n\
+             [[bodies.loads]]\nnodes = [2]\nforce = [0.0, {}]\n{schedule}",
+            here.join("von_mises.nodes").display(),
+            here.join("von_mises.links").display(),
+            -factor * 7622.0
+        ),
+    )
+    .unwrap();
+    scene
+}
+
+/// Every step's warnings of the scene at `path`, solved step by step (step, warning).
+fn warnings_of(path: &std::path::Path) -> Vec<(usize, String)> {
+    let world = linkage::scene::load_scene(path).unwrap();
+    let mut sim = linkage::scene::Simulation::new(&world).unwrap();
+    let mut out = Vec::new();
+    for step in 0..=world.steps {
+        let (_, summary) = sim.step(step).unwrap();
+        out.extend(summary.warnings.into_iter().map(|w| (step, w)));
+    }
+    out
+}
+
+/// Under load control, 10 steps to 1.2 times the limit load: step 9 passes the limit and
+/// Newton lands on the inverted branch (the apex drops from 0.03 m to 0.21 m, 21 times the
+/// step before's change for the same load change). The run says so in summary.json and on the
+/// command line, naming the step and the arc-length method; no other step warns.
+#[test]
+fn load_controlled_von_mises_truss_past_its_limit_warns() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = von_mises_scene(dir.path(), 10, 1.2, None, "");
+    let out = dir.path().join("out");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_linkage"))
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    let warned: Vec<&str> = stdout.lines().filter(|l| l.starts_with("warn")).collect();
+    assert_eq!(warned.len(), 1, "{stdout}");
+    for part in [
+        "warn  vm: step 9: body 'truss': the displacements jumped",
+        "snapped through past a limit point",
+        "[bodies.path] method = \"arc_length\"",
+    ] {
+        assert!(warned[0].contains(part), "{part:?} in {}", warned[0]);
+    }
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("vm/summary.json")).unwrap()).unwrap();
+    for s in summary["steps"].as_array().unwrap() {
+        let w = s["warnings"].as_array().map_or(0, |w| w.len());
+        assert_eq!(w, usize::from(s["step"] == 9), "step {}", s["step"]);
+    }
+    let w9 = summary["steps"][9]["warnings"][0].as_str().unwrap();
+    assert!(
+        w9.starts_with("step 9: body 'truss'") && w9.contains("arc_length"),
+        "{w9}"
+    );
+}
+
+/// The same truss traced by the arc-length method (the bundled scene, through both limit
+/// points and one negative pivot between them) is not warned about: that path is the point.
+#[test]
+fn arc_length_von_mises_truss_does_not_warn() {
+    let warnings = warnings_of(std::path::Path::new("scenes/von_mises_truss.toml"));
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let dir = tempfile::tempdir().unwrap();
+    let scene = von_mises_scene(
+        dir.path(),
+        20,
+        1.2,
+        None,
+        "[bodies.path]\nmethod = \"arc_length\"\narc_length = 0.02",
+    );
+    let warnings = warnings_of(&scene);
+    assert!(warnings.is_empty(), "{warnings:?}");
+}
+
+/// Ordinary nonlinear paths do not warn: the truss softening up to 95 % of its limit, the
+/// same truss loaded by a schedule that jumps 50 times (the displacement follows the load),
+/// the stiffening cable net, and a linear scene.
+#[test]
+fn ordinary_nonlinear_and_linear_scenes_do_not_warn() {
+    let dir = tempfile::tempdir().unwrap();
+    let softening = von_mises_scene(dir.path(), 5, 0.95, None, "");
+    assert!(warnings_of(&softening).is_empty());
+    let jumping = von_mises_scene(dir.path(), 3, 0.6, Some(&[0.01, 0.02, 1.0]), "");
+    assert!(warnings_of(&jumping).is_empty());
+    for scene in ["scenes/cable_net.toml", "scenes/paper_overload.toml"] {
+        let warnings = warnings_of(std::path::Path::new(scene));
+        assert!(warnings.is_empty(), "{scene}: {warnings:?}");
+    }
+}
+
+/// A straight two-bar column held sideways at its middle node by a soft bar (1000 N/m)
+/// buckles at 500 N of compression (the bars' geometric stiffness −2P/L cancels the spring);
+/// under load control it stays straight, an unstable equilibrium whose tangent has one
+/// negative pivot: every step past 500 N warns, naming it.
+#[test]
+fn buckled_column_under_load_control_warns_of_negative_pivots() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("c.nodes"), "0 0\n1 0\n2 0\n1 1\n").unwrap();
+    std::fs::write(dir.path().join("c.links"), "1 2\n2 3\n2 4 soft\n").unwrap();
+    let scene = dir.path().join("c.toml");
+    std::fs::write(
+        &scene,
+        "name = \"c\"\nsteps = 4\n[[materials]]\nname = \"steel\"\nyoungs_modulus = 200e9\narea = 1e-4\n\
+         [[materials]]\nname = \"soft\"\nyoungs_modulus = 1e7\narea = 1e-4\n\
+         [[bodies]]\nname = \"column\"\nnodes = \"c.nodes\"\nlinks = \"c.links\"\nmaterial = \"steel\"\nkinematics = \"large\"\n\
+         [[bodies.supports]]\nnodes = [1, 4]\nfix = [\"x\", \"y\"]\n\
+         [[bodies.supports]]\nnodes = [3]\nfix = [\"y\"]\n\
+         [[bodies.loads]]\nnodes = [3]\nforce = [-1200.0, 0.0]\n",
+    )
+    .unwrap();
+    let warnings = warnings_of(&scene);
+    // 300, 600, 900, 1200 N: steps 2 to 4 are past 500 N.
+    let steps: Vec<usize> = warnings.iter().map(|(s, _)| *s).collect();
+    assert_eq!(steps, [2, 3, 4], "{warnings:?}");
+    for (step, w) in &warnings {
+        assert!(
+            w.starts_with(&format!("step {step}: body 'column': the tangent stiffness at the solved state has 1 negative pivot"))
+                && w.contains("method = \"arc_length\""),
+            "{w}"
+        );
+    }
+}

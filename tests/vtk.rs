@@ -443,3 +443,42 @@ vtk = true
     }
     assert!(disk_segments >= 16, "{disk_segments}");
 }
+
+/// The same run's ParaView files in both encodings: the binary ones (the default) are
+/// compressed, far smaller, and meshio reads the same arrays from them as from ASCII, to the
+/// last bit; the obstacles' file too.
+#[test]
+fn binary_and_ascii_files_carry_the_same_arrays() {
+    let python = meshio_python();
+    let out = tempfile::tempdir().unwrap();
+    let mut sizes = Vec::new();
+    let mut read = Vec::new();
+    for (k, encoding) in [
+        linkage::scene::VtkEncoding::Binary,
+        linkage::scene::VtkEncoding::Ascii,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut world = load_scene(Path::new("scenes/shell_on_block_moving.toml")).unwrap();
+        world.pictures.vtk = true;
+        world.pictures.vtk_encoding = encoding;
+        let root = out.path().join(k.to_string());
+        run(&world, &root, &|| {}).unwrap();
+        let dir = root.join(&world.name);
+        let body = dir.join("vtk/0004.vtu");
+        let obstacles = dir.join("vtk/obstacles_0004.vtu");
+        let text = std::fs::read(&body).unwrap();
+        let appended = String::from_utf8_lossy(&text).contains("format=\"appended\"");
+        assert_eq!(appended, encoding == linkage::scene::VtkEncoding::Binary);
+        sizes.push(text.len());
+        read.push((read_vtu(&python, &body), read_vtu(&python, &obstacles)));
+    }
+    assert_eq!(read[0], read[1], "binary and ASCII arrays differ");
+    assert!(
+        sizes[0] * 2 < sizes[1],
+        "binary {} bytes against ASCII {}",
+        sizes[0],
+        sizes[1]
+    );
+}

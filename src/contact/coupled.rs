@@ -1,5 +1,6 @@
 //! The coupled Newton of all bodies in contact: one sparse system of members and penalties, refactored per iteration (or kept while a linear model converges fast).
 
+use crate::contact::coupled_iterative::CoupledIterative;
 use crate::contact::coupled_system::CoupledSystem;
 use crate::contact::evaluate::{Evaluated, Evaluation};
 use crate::contact::settle::{largest_nodal_move, BodyPart, Problem, STABILISATION};
@@ -7,7 +8,7 @@ use crate::contact::{ActiveContact, ContactError, ContactSet};
 use crate::linalg::CholeskyError;
 use crate::linkage::body_state::{fill_tangent, internal_force_vector, norm};
 use crate::linkage::line_search::backtrack;
-use crate::linkage::{Convergence, PhaseTimes, StiffnessAssembly};
+use crate::linkage::{Convergence, PhaseTimes, SolverUsed, StiffnessAssembly};
 use crate::Real;
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -24,21 +25,28 @@ pub(crate) struct CoupledSolver {
     factored: Option<ContactSet>,
     /// The body whose tangent was singular last (for messages).
     pub(crate) unheld: usize,
+    /// Negative pivots of the last tangent factored (LDLᵀ; 0 when positive definite).
+    pub(crate) negative_pivots: usize,
+    /// Conjugate gradients, when a body is solved iteratively.
+    iterative: Option<CoupledIterative>,
 }
 
 impl CoupledSolver {
-    /// The coupled pattern of `parts`, analyzed (an empty system when `analyze` is false: the
-    /// condensed path builds it only if it falls back).
+    /// The coupled pattern of `parts`, analyzed (an empty system when `build` is false: the
+    /// condensed path builds it only if it falls back). With `iterative` (a body solved by
+    /// conjugate gradients) the pattern is analyzed only if a direct factorization is needed.
     pub(crate) fn new(
         parts: &[BodyPart],
         node_offsets: Vec<usize>,
-        analyze: bool,
+        build: bool,
+        iterative: Option<CoupledIterative>,
     ) -> Result<Self, ContactError> {
-        let system = if analyze {
+        let analyze = iterative.is_none();
+        let system = if build {
             let assemblies: Vec<&StiffnessAssembly> = parts.iter().map(|p| &p.assembly).collect();
-            CoupledSystem::new(&assemblies, &node_offsets, &[])
+            CoupledSystem::new(&assemblies, &node_offsets, &[], analyze)
         } else {
-            CoupledSystem::new(&[], &[], &[])
+            CoupledSystem::new(&[], &[], &[], analyze)
         }
         .map_err(ContactError::Factorization)?;
         Ok(CoupledSolver {
@@ -47,22 +55,43 @@ impl CoupledSolver {
             coupling: Vec::new(),
             factored: None,
             unheld: 0,
+            negative_pivots: 0,
+            iterative,
         })
     }
 
     /// The coupled pattern of all bodies with the entries between bodies so far, analyzed.
     pub(crate) fn rebuild(&mut self, parts: &[BodyPart]) -> Result<(), ContactError> {
         let assemblies: Vec<&StiffnessAssembly> = parts.iter().map(|p| &p.assembly).collect();
-        self.system = CoupledSystem::new(&assemblies, &self.node_offsets, &self.coupling)
-            .map_err(ContactError::Factorization)?;
+        self.system = CoupledSystem::new(
+            &assemblies,
+            &self.node_offsets,
+            &self.coupling,
+            self.iterative.is_none(),
+        )
+        .map_err(ContactError::Factorization)?;
+        self.factored = None;
         Ok(())
+    }
+
+    /// Conjugate-gradient iterations so far (0 when every body is solved directly).
+    pub(crate) fn linear_iterations(&self) -> usize {
+        self.iterative.as_ref().map_or(0, |i| i.iterations)
+    }
+
+    /// The linear solver body `b`'s rows get.
+    pub(crate) fn solver_used(&self, b: usize) -> SolverUsed {
+        match &self.iterative {
+            Some(i) if i.iterative.get(b).copied().unwrap_or(false) => SolverUsed::Iterative,
+            _ => SolverUsed::Direct,
+        }
     }
 
     /// The out-of-balance force `F + f_c − f_int` at the free DOFs of all bodies (global
     /// order), N, for the contacts `evaluated` at the current displacements; and the force
     /// scale it is measured against: the largest of the applied, reaction and contact force
     /// norms, at least the force floor.
-    fn out_of_balance(
+    pub(crate) fn out_of_balance(
         &self,
         p: &Problem,
         parts: &[BodyPart],
@@ -124,20 +153,41 @@ impl CoupledSolver {
             // Linear bodies with the same contacts keep their tangent but for the small turn of
             // the contact normals: reuse the factor (a modified Newton step) while it converges.
             let reuse = linear
+                && self.iterative.is_none()
                 && self.factored.as_ref() == Some(p.set)
                 && iterations > 0
                 && monitor.converging_fast();
-            let stabilised = if reuse {
-                false
+            let (stabilised, delta) = if reuse {
+                let t = Instant::now();
+                let mut delta = r;
+                self.system.solve_in_place(&mut delta);
+                times.solve += t.elapsed().as_secs_f64();
+                (false, delta)
             } else {
-                let stabilised = self.factorize_tangent(p, parts, &evaluated.list, times)?;
-                self.factored = (!stabilised).then(|| p.set.clone());
-                stabilised
+                self.fill_tangent(p, parts, &evaluated.list, times)?;
+                let t = Instant::now();
+                let solved = self
+                    .iterative
+                    .as_mut()
+                    .and_then(|it| it.solve(&self.system, p.set, &r, scale, 0.1 * p.tolerance));
+                times.solve += t.elapsed().as_secs_f64();
+                match solved {
+                    Some(delta) => {
+                        self.negative_pivots = 0;
+                        (false, delta)
+                    }
+                    None => {
+                        // Direct (conjugate gradients could not serve: a singular block).
+                        let stabilised = self.factorize_filled(p, times)?;
+                        self.factored = (!stabilised).then(|| p.set.clone());
+                        let t = Instant::now();
+                        let mut delta = r;
+                        self.system.solve_in_place(&mut delta);
+                        times.solve += t.elapsed().as_secs_f64();
+                        (stabilised, delta)
+                    }
+                }
             };
-            let t = Instant::now();
-            let mut delta = r;
-            self.system.solve_in_place(&mut delta);
-            times.solve += t.elapsed().as_secs_f64();
             iterations += 1;
             if stabilised {
                 // A body flying toward its contacts: move it at most the move cap, then look
@@ -171,17 +221,14 @@ impl CoupledSolver {
         }
     }
 
-    /// Fill the coupled tangent (members plus the penalties of the contacts `evaluated`) and
-    /// factor it. When it is singular (a body not held by its supports and the contacts),
-    /// factor it again with `STABILISATION` times its largest diagonal entry added to the
-    /// diagonal and return true.
-    fn factorize_tangent(
+    /// Fill the coupled tangent: members plus the penalties of the contacts `evaluated`.
+    fn fill_tangent(
         &mut self,
         p: &Problem,
         parts: &mut [BodyPart],
         evaluated: &[Evaluated],
         times: &mut PhaseTimes,
-    ) -> Result<bool, ContactError> {
+    ) -> Result<(), ContactError> {
         let t = Instant::now();
         self.couple(parts, evaluated, times)?;
         for (part, body) in parts.iter_mut().zip(p.bodies) {
@@ -217,17 +264,43 @@ impl CoupledSolver {
             }
         }
         times.assembly += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Factor the filled tangent. When it is singular (a body not held by its supports and the
+    /// contacts), factor it again with `STABILISATION` times its largest diagonal entry added
+    /// to the diagonal and return true. When that fails too, the tangent is indefinite (a body
+    /// buckling under contact): LDLᵀ, its negative pivots counted.
+    fn factorize_filled(
+        &mut self,
+        p: &Problem,
+        times: &mut PhaseTimes,
+    ) -> Result<bool, ContactError> {
         let t = Instant::now();
         let mut result = self.system.factorize();
         let mut stabilised = false;
+        self.negative_pivots = 0;
         if let Err(CholeskyError::NonPositivePivot { dof })
         | Err(CholeskyError::NearlySingular { dof, .. }) = result
         {
             let (b, _) = self.system.locate(dof);
             self.unheld = b;
+            let values = p
+                .bodies
+                .iter()
+                .any(|b| b.is_nonlinear())
+                .then(|| self.system.values.clone());
             self.system.stabilise(STABILISATION);
             stabilised = true;
             result = self.system.factorize();
+            if let (Err(_), Some(values)) = (&result, values) {
+                // Not merely singular: indefinite beyond the stabilisation.
+                self.system.values = values;
+                result = self.system.factorize_indefinite().map(|negative| {
+                    self.negative_pivots = negative;
+                });
+                stabilised = false;
+            }
         }
         times.numeric += t.elapsed().as_secs_f64();
         result.map_err(ContactError::Factorization)?;

@@ -3,6 +3,7 @@
 //! the active contacts, factored together.
 
 use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
+use crate::linalg::SparseLdlt;
 use crate::linkage::StiffnessAssembly;
 use crate::Real;
 
@@ -19,17 +20,27 @@ pub(crate) struct CoupledSystem {
     places: Vec<Vec<usize>>,
     /// Values in the global pattern, N/m.
     pub values: Vec<Real>,
+    /// Node of each row (the ordering keeps a node's DOFs together).
+    groups: Vec<usize>,
+    /// Analyzed at construction, or on the first factorization when `new` was told not to
+    /// (bodies solved iteratively factor only when conjugate gradients cannot serve).
     cholesky: Option<SparseCholesky>,
+    /// LDLᵀ on the same ordering, built the first time the tangent is indefinite.
+    ldlt: Option<SparseLdlt>,
+    /// Whether the last factorization is the LDLᵀ one.
+    indefinite: bool,
 }
 
 impl CoupledSystem {
     /// The pattern of `assemblies` on the diagonal (body order) plus the entries `extra`
     /// (global free DOF pairs, either order: contacts between bodies); `node_offsets[b]` is the
-    /// first global node of body b (the ordering keeps the DOFs of a node together).
+    /// first global node of body b (the ordering keeps the DOFs of a node together). The
+    /// pattern is analyzed at once when `analyze`, else on the first factorization.
     pub(crate) fn new(
         assemblies: &[&StiffnessAssembly],
         node_offsets: &[usize],
         extra: &[(usize, usize)],
+        analyze: bool,
     ) -> Result<Self, CholeskyError> {
         let mut offsets = Vec::with_capacity(assemblies.len());
         let mut n = 0;
@@ -80,7 +91,7 @@ impl CoupledSystem {
             }
             places.push(place);
         }
-        let cholesky = if n > 0 {
+        let cholesky = if n > 0 && analyze {
             Some(SparseCholesky::analyze(
                 n,
                 &col_ptr,
@@ -97,8 +108,21 @@ impl CoupledSystem {
             col_ptr,
             row_idx,
             places,
+            groups,
             cholesky,
+            ldlt: None,
+            indefinite: false,
         })
+    }
+
+    /// The lower triangle's column starts.
+    pub(crate) fn col_ptr(&self) -> &[usize] {
+        &self.col_ptr
+    }
+
+    /// The lower triangle's row of each entry.
+    pub(crate) fn row_idx(&self) -> &[usize] {
+        &self.row_idx
     }
 
     /// Whether entry (`r`, `c`) (either order) is in the pattern.
@@ -158,14 +182,51 @@ impl CoupledSystem {
 
     /// Factor the current values (LLᵀ).
     pub(crate) fn factorize(&mut self) -> Result<(), CholeskyError> {
+        self.indefinite = false;
+        if self.cholesky.is_none() && self.n > 0 {
+            self.cholesky = Some(SparseCholesky::analyze(
+                self.n,
+                &self.col_ptr,
+                &self.row_idx,
+                Some(&self.groups),
+            )?);
+        }
         match self.cholesky.as_mut() {
             Some(c) => c.factorize(&self.values),
             None => Ok(()),
         }
     }
 
-    /// Solve with the last factorization, in place.
+    /// Factor the current values by LDLᵀ (an indefinite tangent, after LLᵀ failed on it) on
+    /// the ordering of the LLᵀ. Returns the number of negative pivots.
+    pub(crate) fn factorize_indefinite(&mut self) -> Result<usize, CholeskyError> {
+        self.indefinite = false;
+        let Some(cholesky) = self.cholesky.as_ref() else {
+            return Ok(0);
+        };
+        if self.ldlt.is_none() {
+            self.ldlt = Some(SparseLdlt::with_ordering_of(
+                cholesky,
+                &self.col_ptr,
+                &self.row_idx,
+            )?);
+        }
+        let Some(ldlt) = self.ldlt.as_mut() else {
+            return Ok(0);
+        };
+        let negative = ldlt.factorize(&self.values)?;
+        self.indefinite = true;
+        Ok(negative)
+    }
+
+    /// Solve with the last factorization (LLᵀ or LDLᵀ), in place.
     pub(crate) fn solve_in_place(&mut self, rhs: &mut [Real]) {
+        if self.indefinite {
+            if let Some(l) = self.ldlt.as_mut() {
+                l.solve_in_place(rhs);
+                return;
+            }
+        }
         if let Some(c) = self.cholesky.as_mut() {
             c.solve_in_place(rhs);
         }

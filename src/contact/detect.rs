@@ -132,6 +132,12 @@ impl Geometry {
         self.features.record(active, start, offsets);
     }
 
+    /// Forget the crossings found since the last [`Geometry::record_crossings`] (an increment
+    /// undone).
+    pub(crate) fn forget_crossings_found(&mut self) {
+        self.features.forget_pending();
+    }
+
     /// Where `node` of `body` at `x` stands against obstacle `o` at `offset` (m): depth and
     /// normal. Inside a polyhedral obstacle (or `held` in contact with it), behind the face
     /// (edge, corner) it crossed since the last solved state; else (a smooth obstacle, a node

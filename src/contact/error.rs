@@ -33,21 +33,27 @@ pub enum ContactError {
         /// The moving nodes.
         mechanism: Box<crate::linkage::Mechanism>,
     },
-    /// Newton did not converge within one contact iteration.
-    #[error("step {step}: equilibrium with contact did not converge in {iterations} Newton iterations (relative residuals: [{}]): use more steps, or a smaller [contact] penalty", history.iter().map(|r| format!("{r:.1e}")).collect::<Vec<_>>().join(", "))]
+    /// A step did not converge even with its increment halved `depth` (= the smallest
+    /// `[bodies.newton] max_cuts`) times.
+    #[error("step {step}: equilibrium with contact did not converge, even with its increment cut to 1/{} of the step ({depth} halvings deep, the most [bodies.newton] max_cuts allows; {cuts} halvings in this step in all, as the increment grows again after two successes): {reason}; relative residuals of the last attempt: [{}]. Use more steps (smaller increments), raise [bodies.newton] max_cuts or max_iterations, or a smaller [contact] penalty", 1u64 << (*.depth).min(63), history.iter().map(|r| format!("{r:.1e}")).collect::<Vec<_>>().join(", "))]
     NotConverged {
         /// The step.
         step: usize,
-        /// Newton iterations done.
-        iterations: usize,
-        /// Relative residual after each.
+        /// Halvings of the increment in force when it failed.
+        depth: usize,
+        /// Halvings in this step in all.
+        cuts: usize,
+        /// Why the last attempt failed.
+        reason: String,
+        /// Relative residual after each Newton iteration of the last attempt.
         history: Vec<Real>,
     },
     /// The sparse factorization failed for another reason.
     #[error("the sparse factorization of the bodies in contact failed: {0}")]
     Factorization(CholeskyError),
-    /// The arc-length method is not available with contact.
-    #[error("body '{body}': [bodies.path] method = \"arc_length\" cannot be combined with contact (obstacles or several bodies): use the default load schedules")]
+    /// The arc-length method is not available with contact: the load factor of one body's
+    /// path does not say where the obstacles and the other bodies are.
+    #[error("body '{body}': [bodies.path] method = \"arc_length\" cannot be combined with contact (obstacles or a [contact] table): the arc length scales one body's loads by a factor it finds, while the obstacles' travel and the other bodies follow their schedules. Use the default load schedules; a contact step that Newton cannot solve at once is crossed in halved increments (see [bodies.newton] max_cuts)")]
     ArcLength {
         /// Body name.
         body: String,

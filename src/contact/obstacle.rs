@@ -1,5 +1,6 @@
 //! A rigid obstacle as plain data: its shape, where it is, and how it moves over the steps.
 
+use crate::linkage::body_state::factor_at;
 use crate::linkage::Schedule;
 use crate::Real;
 use nalgebra::Vector3;
@@ -83,5 +84,37 @@ impl Obstacle {
             return Vector3::zeros();
         }
         self.travel * self.schedule.factor(step, steps)
+    }
+
+    /// The obstacle's translation at pseudo-time `t` (step units, fractional between steps:
+    /// the schedule interpolated linearly, exact at whole steps), m.
+    pub fn offset_at(&self, t: Real, steps: usize) -> Vector3<Real> {
+        if self.travel == Vector3::zeros() {
+            return Vector3::zeros();
+        }
+        self.travel * factor_at(&self.schedule, t, steps)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offset_at_whole_steps_is_the_step_offset_and_linear_between() {
+        let o = Obstacle {
+            name: "press".to_string(),
+            shape: ObstacleShape::Ball {
+                center: Vector3::zeros(),
+                radius: 1.0,
+            },
+            travel: Vector3::new(0.0, -0.4, 0.0),
+            schedule: Schedule::Factors(vec![0.5, 1.0]),
+        };
+        for k in 0..=2 {
+            assert_eq!(o.offset_at(k as Real, 2), o.offset(k, 2));
+        }
+        // Halfway between step 1 (0.5) and step 2 (1.0): factor 0.75.
+        assert!((o.offset_at(1.5, 2).y + 0.3).abs() < 1e-15);
     }
 }

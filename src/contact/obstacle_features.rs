@@ -333,6 +333,14 @@ impl Features {
         self.start_offsets.get(o).copied().unwrap_or_default()
     }
 
+    /// Forget the crossings found since the last [`Features::record`].
+    pub(crate) fn forget_pending(&mut self) {
+        self.pending
+            .get_mut()
+            .unwrap_or_else(|e| e.into_inner())
+            .clear();
+    }
+
     /// Commit the crossings of the contacts of `active` (the last solved state, the node
     /// positions `start` and obstacle `offsets` there, m) and forget the others.
     pub(crate) fn record(

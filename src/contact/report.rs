@@ -17,8 +17,16 @@ pub struct ContactStep {
     pub contacts: Vec<Vec<NodeContact>>,
     /// Contact iterations (solves with a fixed contact set) the step took.
     pub contact_iterations: usize,
-    /// Newton iterations, all contact iterations together.
+    /// Newton iterations, all contact iterations and increments together (failed attempts
+    /// included).
     pub newton_iterations: usize,
+    /// Halvings of the increment in this step (0: crossed in one increment).
+    pub cuts: usize,
+    /// Negative pivots of the last coupled tangent factored (LDLᵀ: a body buckling under
+    /// contact; 0 when it was positive definite).
+    pub negative_pivots: usize,
+    /// Conjugate-gradient iterations of the step (bodies solved iteratively).
+    pub linear_iterations: usize,
     /// Largest penetration at the solution, m.
     pub max_penetration: Real,
     /// What the user should know: penetration above tolerance, a contact set that did not

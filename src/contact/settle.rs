@@ -2,6 +2,7 @@
 
 use crate::contact::condensed::CondensedSolver;
 use crate::contact::coupled::CoupledSolver;
+use crate::contact::coupled_iterative::CoupledIterative;
 use crate::contact::detect::{candidate_nodes, Geometry};
 use crate::contact::evaluate::{evaluate, Evaluation};
 use crate::contact::report::{finish, ContactStep};
@@ -12,7 +13,8 @@ use crate::contact::{
 };
 use crate::linkage::body_state::{loads_at, node_vector, prescribed_at};
 use crate::linkage::{
-    Body, Convergence, DofMap, Mechanism, PathMethod, PhaseTimes, SolveError, StiffnessAssembly,
+    Body, Convergence, DofMap, Mechanism, PathMethod, PhaseTimes, SolveError, SolverUsed,
+    StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
@@ -25,6 +27,10 @@ pub const STABILISATION: Real = 1e-9;
 
 /// See [`ContactSolver::force_floor`].
 pub const FORCE_FLOOR: Real = 1e-10;
+
+/// Converged states kept for the extrapolated start of an increment (three: up to a
+/// quadratic through them, as a body's Newton).
+pub(crate) const PATH_POINTS: usize = 3;
 
 /// One body's part of the solve.
 pub(crate) struct BodyPart {
@@ -121,7 +127,9 @@ impl Problem<'_> {
         if iterations >= self.max_iterations {
             return Err(ContactError::NotConverged {
                 step: self.step,
-                iterations,
+                depth: 0,
+                cuts: 0,
+                reason: format!("no convergence in {iterations} Newton iterations"),
                 history: monitor.history.clone(),
             });
         }
@@ -157,24 +165,29 @@ pub(crate) fn largest_nodal_move(part: &BodyPart, mut moved: impl FnMut(usize) -
 /// with a warning, as does running out of contact iterations. When every body is linear, the
 /// Newton runs on the contact candidates instead ([`CondensedSolver`]).
 pub struct ContactSolver {
-    parts: Vec<BodyPart>,
-    geometry: Geometry,
-    coupled: CoupledSolver,
+    pub(crate) parts: Vec<BodyPart>,
+    pub(crate) geometry: Geometry,
+    pub(crate) coupled: CoupledSolver,
     /// Every body linear: each factored once per run and condensed on its contact candidates
     /// (`None`: the coupled solve).
-    condensed: Option<CondensedSolver>,
+    pub(crate) condensed: Option<CondensedSolver>,
     /// A body found to move inside itself (beyond rigid motions) when it was condensed: named
     /// if no contact holds it either.
-    mechanism: Option<Box<Mechanism>>,
-    settings: ContactSettings,
+    pub(crate) mechanism: Option<Box<Mechanism>>,
+    pub(crate) settings: ContactSettings,
     /// The contact set of the last solved step (the next step starts from it).
-    active: ContactSet,
+    pub(crate) active: ContactSet,
     /// The last normal seen per contact (used when a node lies exactly on the surface).
-    normals: HashMap<ActiveContact, Vector3<Real>>,
+    pub(crate) normals: HashMap<ActiveContact, Vector3<Real>>,
     /// The step the displacements belong to.
-    step: usize,
+    pub(crate) step: usize,
     /// Largest nodal move of a stabilised iteration, m: the smallest mean member length.
-    move_cap: Real,
+    pub(crate) move_cap: Real,
+    /// The last converged states (pseudo-time, displacements per body), newest last, at most
+    /// [`PATH_POINTS`]: an increment on the coupled path starts from their extrapolation.
+    pub(crate) path: Vec<(Real, Vec<Vec<Real>>)>,
+    /// Conjugate-gradient iterations before the step being solved.
+    pub(crate) linear_before: usize,
     /// Time spent so far in each phase, s.
     pub times: PhaseTimes,
     /// Time spent so far finding contacts (projecting nodes on obstacles), s.
@@ -226,7 +239,13 @@ impl ContactSolver {
         no_start_overlap(bodies, &parts, &geometry)?;
         let mut condensed = None;
         let mut mechanism = None;
-        if settings.condense && bodies.iter().all(|b| !b.is_nonlinear()) {
+        let iterative = {
+            let dofs: Vec<&DofMap> = parts.iter().map(|p| &p.dofs).collect();
+            let assemblies: Vec<&StiffnessAssembly> = parts.iter().map(|p| &p.assembly).collect();
+            CoupledIterative::new(bodies, &dofs, &assemblies)
+        };
+        // Condensing needs a factorization of every body: not for one solved iteratively.
+        if settings.condense && iterative.is_none() && bodies.iter().all(|b| !b.is_nonlinear()) {
             // Obstacle offsets along their travel, sampled (a candidate missed is added later).
             let travels: Vec<Vec<Vector3<Real>>> = obstacles
                 .iter()
@@ -236,7 +255,7 @@ impl ContactSolver {
             (condensed, mechanism) = CondensedSolver::build(bodies, &parts, marks, &mut times);
         }
         let t = Instant::now();
-        let coupled = CoupledSolver::new(&parts, node_offsets, condensed.is_none())?;
+        let coupled = CoupledSolver::new(&parts, node_offsets, condensed.is_none(), iterative)?;
         times.symbolic += t.elapsed().as_secs_f64();
         Ok(ContactSolver {
             move_cap: bodies
@@ -253,6 +272,11 @@ impl ContactSolver {
             active: ContactSet::default(),
             normals: HashMap::new(),
             step: 0,
+            path: vec![(
+                0.0,
+                bodies.iter().map(|b| vec![0.0; b.dof_count()]).collect(),
+            )],
+            linear_before: 0,
             times,
             query_seconds: 0.0,
         })
@@ -273,7 +297,7 @@ impl ContactSolver {
     /// smallest penalty times the smallest tolerance (a force of the order of a member's
     /// `E A`). Where nothing is loaded (step 0, a node touching a surface at a depth of
     /// round-off) the residual is then round-off over a real force, not round-off over round-off.
-    fn force_floor(&self) -> Real {
+    pub(crate) fn force_floor(&self) -> Real {
         let k = self
             .parts
             .iter()
@@ -297,6 +321,12 @@ impl ContactSolver {
         self.parts.get(body).map_or(0, |p| p.assembly.n)
     }
 
+    /// The linear solver `body`'s rows get: "iterative" (conjugate gradients on the coupled
+    /// tangent, multigrid on the body's block) or "direct".
+    pub fn solver_used(&self, body: usize) -> SolverUsed {
+        self.coupled.solver_used(body)
+    }
+
     /// The penalty stiffness used for `body`, N/m.
     pub fn penalty(&self, body: usize) -> Real {
         self.parts.get(body).map_or(0.0, |p| p.penalty.stiffness)
@@ -318,41 +348,23 @@ impl ContactSolver {
         found
     }
 
-    /// Solve `step` of `steps` for `bodies` (the ones given to [`ContactSolver::new`]).
-    /// Steps are meant to come in order: each starts from the displacements and the contact
-    /// set of the step before (asking for step 0 starts over).
-    pub fn solve_step(
+    /// The settle loop at pseudo-time `t` of `steps` (the end of an increment of step `step`,
+    /// which messages name), from the current displacements and contact set `self.active`:
+    /// loads, prescribed displacements and obstacles at `t`. Leaves the settled set in
+    /// `self.active` and returns the counts and warnings (the states are reported by
+    /// [`ContactSolver::report`]).
+    pub(crate) fn settle(
         &mut self,
         bodies: &[Body],
         obstacles: &[Obstacle],
-        step: usize,
+        t: Real,
         steps: usize,
+        step: usize,
     ) -> Result<ContactStep, ContactError> {
-        let restart = step == 0 || step < self.step;
-        if restart {
-            for p in &mut self.parts {
-                p.u.iter_mut().for_each(|v| *v = 0.0);
-            }
-            self.active = ContactSet::default();
-            self.normals.clear();
-        }
-        self.geometry
-            .record_sides(bodies, &self.parts, &self.active);
-        let last = if restart { 0 } else { self.step };
-        let last_offsets = obstacles.iter().map(|o| o.offset(last, steps)).collect();
-        self.geometry
-            .record_crossings(bodies, &self.parts, &self.active, last_offsets);
-        if let Some(c) = self.condensed.as_mut() {
-            c.start_step(step, steps, restart);
-        }
-        self.step = step;
-        let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset(step, steps)).collect();
-        let forces: Vec<Vec<Real>> = bodies
-            .iter()
-            .map(|b| loads_at(b, step as Real, steps))
-            .collect();
+        let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
+        let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
         for (part, body) in self.parts.iter_mut().zip(bodies) {
-            let prescribed = prescribed_at(body, step as Real, steps);
+            let prescribed = prescribed_at(body, t, steps);
             for &dof in &part.dofs.supported {
                 part.u[dof] = prescribed[dof];
             }
@@ -421,9 +433,22 @@ impl ContactSolver {
         }
         self.active = set;
         self.expand_condensed();
-        if let Some(c) = self.condensed.as_mut() {
-            c.solved(step);
-        }
+        Ok(out)
+    }
+
+    /// The report of the settled end of `step` of `steps` (states, contacts, totals) into
+    /// `out`, from the current displacements and contact set.
+    pub(crate) fn report(
+        &mut self,
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        step: usize,
+        steps: usize,
+        mut out: ContactStep,
+    ) -> Result<ContactStep, ContactError> {
+        let t = step as Real;
+        let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
+        let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
         let (tolerance, max_iterations) = newton_limits(bodies);
         let problem = Problem {
             bodies,
@@ -438,6 +463,8 @@ impl ContactSolver {
             force_floor: self.force_floor(),
         };
         let evaluated = problem.evaluate(&mut self.normals, &self.parts);
+        out.negative_pivots = self.coupled.negative_pivots;
+        out.linear_iterations = self.coupled.linear_iterations() - self.linear_before;
         finish(&problem, &self.parts, evaluated, out)
     }
 
@@ -486,7 +513,8 @@ impl ContactSolver {
             if let Some(done) = done {
                 return Ok(done);
             }
-            // Leave the condensed path: the coupled solve from the full displacements.
+            // Leave the condensed path: the coupled solve from the full displacements (not
+            // `leave_condensed`: `problem` borrows the geometry).
             self.condensed = None;
             let t = Instant::now();
             self.coupled.rebuild(&self.parts)?;
@@ -503,7 +531,7 @@ impl ContactSolver {
 
 /// The Newton tolerance of a contact scene (the smallest of the bodies', at most 1e-10) and the
 /// iterations allowed per contact set (the largest of the bodies').
-fn newton_limits(bodies: &[Body]) -> (Real, usize) {
+pub(crate) fn newton_limits(bodies: &[Body]) -> (Real, usize) {
     let tolerance = bodies
         .iter()
         .map(|b| b.newton.tolerance)

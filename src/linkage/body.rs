@@ -1,6 +1,8 @@
 //! One body: its nodes, members, patches, materials, supports and loads, and their checks.
 
-use crate::linkage::{Geometry, Kinematics, Material, NewtonSettings, PathMethod, SolverSettings};
+use crate::linkage::{
+    check_members, Geometry, Kinematics, Material, NewtonSettings, PathMethod, SolverSettings,
+};
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -617,36 +619,6 @@ impl MemberProblem {
             },
         }
     }
-}
-
-/// Check members against the nodes: indices in range, two distinct nodes, non-zero
-/// length (below 1e-12 of the model size counts as zero), no pair repeated.
-pub fn check_members(
-    nodes: &[Vector3<Real>],
-    members: impl Iterator<Item = [usize; 2]>,
-) -> Result<(), MemberProblem> {
-    let scale = bounding_diagonal(nodes);
-    let mut seen = std::collections::HashMap::new();
-    for (i, [a, b]) in members.enumerate() {
-        if let Some(&n) = [a, b].iter().find(|&&n| n >= nodes.len()) {
-            return Err(MemberProblem::NodeOutOfRange { member: i, node: n });
-        }
-        if a == b {
-            return Err(MemberProblem::SelfMember { member: i, node: a });
-        }
-        let length = (nodes[b] - nodes[a]).norm();
-        if !(length.is_finite() && scale.is_finite()) {
-            return Err(MemberProblem::TooLarge { member: i });
-        }
-        if length <= 1e-12 * scale || length == 0.0 {
-            return Err(MemberProblem::ZeroLength { member: i, length });
-        }
-        if let Some(&first) = seen.get(&(a.min(b), a.max(b))) {
-            return Err(MemberProblem::Duplicate { member: i, first });
-        }
-        seen.insert((a.min(b), a.max(b)), i);
-    }
-    Ok(())
 }
 
 /// The diagonal of the bounding box of `points`, m (0 for none).

@@ -3,8 +3,8 @@
 pub use self::assembly::ModelTooLarge;
 pub use self::assembly::StiffnessAssembly;
 pub use self::body::{
-    bounding_diagonal, check_members, prescribed_displacements, Body, BodyError, Dimension, Member,
-    MemberProblem, NodalLoad, Schedule, Support,
+    bounding_diagonal, prescribed_displacements, Body, BodyError, Dimension, Member, MemberProblem,
+    NodalLoad, Schedule, Support,
 };
 pub use self::body_solver::BodySolver;
 pub use self::convergence::{Convergence, NotFinite};
@@ -14,8 +14,10 @@ pub use self::geometry::Geometry;
 pub use self::kinematics::{Kinematics, NewtonSettings, PathMethod};
 pub use self::material::{Behaviour, Material};
 pub use self::mechanism::Mechanism;
+pub use self::member_check::check_members;
 pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
+pub(crate) use self::newton::IncrementSize;
 pub use self::newton::NewtonEquilibrium;
 pub use self::solver_choice::{
     IterativeSettings, SolverChoice, SolverSettings, SolverUsed, AUTO_ITERATIVE_DOFS_2D,
@@ -38,6 +40,7 @@ mod kinematics;
 pub(crate) mod line_search;
 mod material;
 pub(crate) mod mechanism;
+mod member_check;
 mod member_response;
 mod member_stiffness;
 mod newton;

@@ -6,6 +6,7 @@ use crate::linkage::{
     Behaviour, Body, Dimension, Geometry, Kinematics, Material, Member, NewtonSettings, NodalLoad,
     PathMethod, Schedule, SolverChoice, SolverSettings, Support,
 };
+use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::selector::{select_nodes, vector};
@@ -204,6 +205,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     let contact = contact_settings(spec.contact.as_ref().map(|c| c.get_ref()))
         .map_err(|e| at(spec.contact.as_ref().map_or(0..0, |c| c.span()), e))?;
     let mut obstacles: Vec<Obstacle> = Vec::new();
+    let mut found = Vec::new();
     for o in &spec.obstacles {
         let dimension = bodies[0].dimension;
         if bodies.iter().any(|b| b.dimension != dimension) {
@@ -212,8 +214,9 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
                 "obstacles need all bodies of one dimension (all 2D or all 3D)".to_string(),
             ));
         }
-        let obstacle = obstacle_from(o.get_ref(), dimension, spec.steps, &bodies, folder)
+        let (obstacle, note) = obstacle_from(o.get_ref(), dimension, spec.steps, &bodies, folder)
             .map_err(|e| at(o.span(), e))?;
+        found.extend(note);
         if obstacles.iter().any(|p| p.name == obstacle.name) {
             return Err(at(
                 o.span(),
@@ -227,6 +230,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     }
     Ok(World {
         obstacles,
+        found,
         contact,
         contact_table: spec.contact.is_some(),
         name: spec.name,
@@ -313,6 +317,27 @@ fn newton_settings(spec: &BodySpec) -> Result<NewtonSettings, String> {
         };
     }
     Ok(settings)
+}
+
+/// Which generator keys a body gives, in the order `disk`, `rectangle`, `cylindrical_shell`,
+/// `box_lattice`.
+fn generated_by(spec: &BodySpec) -> [bool; 4] {
+    [
+        spec.disk.is_some(),
+        spec.rectangle.is_some(),
+        spec.cylindrical_shell.is_some(),
+        spec.box_lattice.is_some(),
+    ]
+}
+
+/// The first node (0-based) with a coordinate beyond [`MAX_LENGTH`] (or not finite), and that
+/// coordinate.
+fn beyond_bound(nodes: &[nalgebra::Vector3<crate::Real>]) -> Option<(usize, crate::Real)> {
+    nodes.iter().enumerate().find_map(|(n, p)| {
+        p.iter()
+            .find(|v| !v.is_finite() || v.abs() > MAX_LENGTH)
+            .map(|v| (n, *v))
+    })
 }
 
 fn build_body(
@@ -421,15 +446,7 @@ fn build_body(
         })
     };
 
-    let generated = [
-        spec.disk.is_some(),
-        spec.rectangle.is_some(),
-        spec.cylindrical_shell.is_some(),
-        spec.box_lattice.is_some(),
-    ]
-    .iter()
-    .filter(|g| **g)
-    .count();
+    let generated = generated_by(spec).iter().filter(|g| **g).count();
     let from_files = spec.nodes.is_some() || spec.links.is_some();
     if generated + usize::from(from_files) != 1 {
         return Err(here(
@@ -451,13 +468,9 @@ fn build_body(
         let links_path = paper_file("links", links_file)?;
         let (dimension, nodes) = paper_files::read_nodes(&nodes_path).map_err(in_file("nodes"))?;
         // Lengths square coordinate differences: past about 1e154 they overflow.
-        if let Some((n, v)) = nodes
-            .iter()
-            .enumerate()
-            .find_map(|(n, p)| p.iter().find(|v| v.abs() > 1e150).map(|v| (n, *v)))
-        {
+        if let Some((n, v)) = beyond_bound(&nodes) {
             return Err(here(format!(
-                "`nodes` = {nodes_file:?}: node {} has the coordinate {v:e}, too large to square (lengths would overflow): give coordinates in metres, below 1e150",
+                "`nodes` = {nodes_file:?}: node {} has the coordinate {v:e}, too large to square (lengths and contact forces would overflow): give coordinates in metres, within ±{MAX_LENGTH:e}",
                 n + 1
             )));
         }
@@ -520,9 +533,27 @@ fn build_body(
             "patches are for 3D bodies; this body's nodes have 2 coordinates".to_string(),
         ));
     }
+    let generator = ["disk", "rectangle", "cylindrical_shell", "box_lattice"]
+        .into_iter()
+        .zip(generated_by(spec))
+        .find_map(|(key, g)| g.then_some(key));
+    if let (Some(key), Some((n, v))) = (generator, beyond_bound(&body.nodes)) {
+        return Err(here(format!(
+            "`{key}` places node {} at the coordinate {v:e} m, too large to square (lengths and contact forces would overflow): give sizes in metres, within ±{MAX_LENGTH:e}",
+            n + 1
+        )));
+    }
     if let Some(offset) = &spec.offset {
-        let shift = vector(offset, body.dimension, "offset").map_err(&here)?;
+        let shift = vector(offset, body.dimension, "offset")
+            .and_then(|v| check_lengths(&v, "offset"))
+            .map_err(&here)?;
         body.nodes.iter_mut().for_each(|p| *p += shift);
+        if let Some((n, v)) = beyond_bound(&body.nodes) {
+            return Err(here(format!(
+                "`offset` moves node {} to the coordinate {v:e} m, too large to square (lengths and contact forces would overflow): keep the body within ±{MAX_LENGTH:e} m",
+                n + 1
+            )));
+        }
     }
 
     let schedule = |s: &Option<Vec<f64>>| -> Result<Schedule, String> {

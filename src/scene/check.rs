@@ -25,6 +25,8 @@ pub struct CheckReport {
     pub bodies: Vec<BodySize>,
     /// What the check cannot decide without solving (a nonlinear body's steps, contacts).
     pub notes: Vec<String>,
+    /// What loading the scene found and changed (mesh faces turned outward).
+    pub found: Vec<String>,
     /// What the run would do that a user may not want (more than 1 GiB of step files).
     pub warnings: Vec<String>,
 }
@@ -53,6 +55,7 @@ pub fn check_world(world: &World) -> Result<CheckReport, RunError> {
         describe: world.describe(),
         bodies: simulation.sizes(),
         notes,
+        found: world.found.clone(),
         warnings: output_warning(world).into_iter().collect(),
     })
 }

@@ -1,4 +1,16 @@
 //! Triangle meshes for obstacles: Wavefront OBJ (`v` and `f` lines), ASCII STL and binary STL.
+//!
+//! Our own reader rather than `tobj` and `stl_io`, on the merits: both crates are well kept but
+//! report a malformed file without saying where (`tobj::LoadError` is a bare
+//! `PositionParseError` or `FaceParseError`; `stl_io::read_stl` returns an `std::io::Error`),
+//! accept non-finite coordinates, and `stl_io` pads or cuts facets whose vertex count is wrong.
+//! A user with a 40 000-line export needs the line (or binary triangle) and what to change,
+//! and an obstacle needs only positions and triangles, which take a few dozen lines per format.
+//! Here every problem names the file and the line: a vertex with a wrong number of
+//! coordinates, a token that is not a number, `nan` or `inf`, a coordinate beyond
+//! [`MAX_COORDINATE`], a face naming vertex 0 or one not defined above it, an STL facet
+//! without exactly three vertices or a line out of place, a zero-area triangle, a file with
+//! no triangles; a binary STL names its triangle and, cut short, both sizes.
 
 use crate::Real;
 use nalgebra::Vector3;
@@ -139,6 +151,13 @@ fn read_binary_stl(path: &Path, bytes: &[u8], count: usize) -> Result<Mesh, Stri
             path.display()
         ));
     }
+    if let Some((t, why)) = degenerate(&vertices, &triangles) {
+        return Err(format!(
+            "{}: binary STL triangle {} (of {count}): {why}: a zero-area face has no outward side; remove it or re-export the file",
+            path.display(),
+            t + 1
+        ));
+    }
     Ok((vertices, triangles))
 }
 
@@ -163,106 +182,280 @@ fn merge_vertex(
 /// Read an OBJ or ASCII STL text (`extension` says which).
 fn read_text_mesh(path: &Path, text: &str, extension: &str) -> Result<Mesh, String> {
     let at = |line: usize, m: String| format!("{}:{line}: {m}", path.display());
-    let number = |line: usize, s: &str| -> Result<Real, String> {
-        s.parse::<Real>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| at(line, format!("{s:?} is not a finite number")))
-    };
-    let mut vertices: Vec<Vector3<Real>> = Vec::new();
-    let mut triangles = Vec::new();
-    match extension {
-        "obj" => {
-            for (i, raw) in text.lines().enumerate() {
-                let line = i + 1;
-                let mut words = raw.split('#').next().unwrap_or("").split_whitespace();
-                match words.next() {
-                    Some("v") => {
-                        let c: Vec<&str> = words.collect();
-                        if c.len() < 3 {
-                            return Err(at(line, "a vertex needs x y z".to_string()));
-                        }
-                        vertices.push(Vector3::new(
-                            number(line, c[0])?,
-                            number(line, c[1])?,
-                            number(line, c[2])?,
-                        ));
-                    }
-                    Some("f") => {
-                        let mut corners = Vec::new();
-                        for w in words {
-                            let index = w.split('/').next().unwrap_or("");
-                            let k: i64 = index
-                                .parse()
-                                .map_err(|_| at(line, format!("{w:?} is not a vertex number")))?;
-                            let k = if k < 0 {
-                                vertices.len() as i64 + k
-                            } else {
-                                k - 1
-                            };
-                            if k < 0 || k as usize >= vertices.len() {
-                                return Err(at(
-                                    line,
-                                    format!(
-                                        "face names vertex {w}, but only {} are defined above it",
-                                        vertices.len()
-                                    ),
-                                ));
-                            }
-                            corners.push(k as usize);
-                        }
-                        if corners.len() < 3 {
-                            return Err(at(line, "a face needs 3 or more vertices".to_string()));
-                        }
-                        for j in 1..corners.len() - 1 {
-                            triangles.push([corners[0], corners[j], corners[j + 1]]);
-                        }
-                    }
-                    _ => {}
-                }
-            }
-        }
-        "stl" => {
-            let mut merged = HashMap::new();
-            let mut corners = Vec::new();
-            for (i, raw) in text.lines().enumerate() {
-                let line = i + 1;
-                let mut words = raw.split_whitespace();
-                if words.next() == Some("vertex") {
-                    let c: Vec<&str> = words.collect();
-                    if c.len() < 3 {
-                        return Err(at(line, "a vertex needs x y z".to_string()));
-                    }
-                    let p = Vector3::new(
-                        number(line, c[0])?,
-                        number(line, c[1])?,
-                        number(line, c[2])?,
-                    );
-                    corners.push(merge_vertex(&mut vertices, &mut merged, p));
-                    if corners.len() == 3 {
-                        triangles.push([corners[0], corners[1], corners[2]]);
-                        corners.clear();
-                    }
-                }
-            }
-            if text.trim_start().starts_with("solid") && triangles.is_empty() {
-                return Err(at(1, "no facets found".to_string()));
-            }
-        }
+    let (vertices, triangles) = match extension {
+        "obj" => read_obj(text, &at)?,
+        "stl" => read_ascii_stl(text, &at)?,
         _ => {
             return Err(format!(
                 "{}: a mesh obstacle reads .obj or .stl (ASCII or binary) files",
                 path.display()
             ))
         }
-    }
+    };
     if triangles.is_empty() {
         return Err(format!(
-            "{}: the file has no triangles (OBJ `f` lines or STL facets)",
+            "{}: the file has no triangles (OBJ `f` lines or STL facets): a mesh obstacle needs a closed surface",
             path.display()
         ));
     }
+    let (triangles, lines): (Vec<_>, Vec<_>) = triangles.into_iter().unzip();
+    if let Some((t, why)) = degenerate(&vertices, &triangles) {
+        return Err(at(
+            lines[t],
+            format!("{why}: a zero-area face has no outward side; remove it or fix its corners"),
+        ));
+    }
     Ok((vertices, triangles))
+}
+
+/// Parse one coordinate: a finite number of metres within [`MAX_COORDINATE`].
+fn coordinate(line: usize, s: &str, at: &dyn Fn(usize, String) -> String) -> Result<Real, String> {
+    match s.parse::<Real>() {
+        Ok(x) if x.is_finite() && x.abs() <= MAX_COORDINATE => Ok(x),
+        Ok(x) if x.is_finite() => Err(at(
+            line,
+            format!(
+                "the coordinate {s} is beyond ±{MAX_COORDINATE:e} m: contact would square it past what f64 holds; give the mesh in metres"
+            ),
+        )),
+        Ok(_) => Err(at(
+            line,
+            format!("the coordinate {s:?} is not a finite number; re-export the file"),
+        )),
+        Err(_) => Err(at(line, format!("{s:?} is not a number"))),
+    }
+}
+
+/// The largest coordinate a mesh vertex may have, m: squares and cross products of such
+/// coordinates stay far inside f64 (the same bound as every other length of a scene).
+pub(crate) const MAX_COORDINATE: Real = crate::scene::bounds::MAX_LENGTH;
+
+/// Triangles with the line each comes from.
+type Lined = Vec<([usize; 3], usize)>;
+
+/// OBJ `v` (x y z, or x y z r g b with vertex colours, which are ignored) and `f` lines (1-based
+/// or negative vertex numbers, `v/vt/vn` forms; polygons fanned into triangles). Other lines
+/// (`vn`, `vt`, `o`, `g`, `usemtl`, ...) carry nothing a rigid obstacle needs.
+fn read_obj(
+    text: &str,
+    at: &dyn Fn(usize, String) -> String,
+) -> Result<(Vec<Vector3<Real>>, Lined), String> {
+    let mut vertices: Vec<Vector3<Real>> = Vec::new();
+    let mut triangles = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let mut words = raw.split('#').next().unwrap_or("").split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let c: Vec<&str> = words.collect();
+                if c.len() != 3 && c.len() != 6 {
+                    return Err(at(
+                        line,
+                        format!(
+                            "a vertex has {} numbers: give x y z (or x y z r g b with colours); a weight w is not read",
+                            c.len()
+                        ),
+                    ));
+                }
+                let mut p = Vector3::zeros();
+                for (k, w) in c.iter().enumerate() {
+                    let x = coordinate(line, w, at)?;
+                    if k < 3 {
+                        p[k] = x;
+                    }
+                }
+                vertices.push(p);
+            }
+            Some("f") => {
+                let mut corners = Vec::new();
+                for w in words {
+                    let index = w.split('/').next().unwrap_or("");
+                    let k: i64 = index
+                        .parse()
+                        .map_err(|_| at(line, format!("{w:?} is not a vertex number")))?;
+                    if k == 0 {
+                        return Err(at(
+                            line,
+                            "face names vertex 0: OBJ vertex numbers start at 1 (or count back from -1)".to_string(),
+                        ));
+                    }
+                    let k = if k < 0 {
+                        vertices.len() as i64 + k
+                    } else {
+                        k - 1
+                    };
+                    if k < 0 || k as usize >= vertices.len() {
+                        return Err(at(
+                            line,
+                            format!(
+                                "face names vertex {w}, but only {} are defined above it",
+                                vertices.len()
+                            ),
+                        ));
+                    }
+                    corners.push(k as usize);
+                }
+                if corners.len() < 3 {
+                    return Err(at(
+                        line,
+                        format!("a face has {} vertices: it needs 3 or more", corners.len()),
+                    ));
+                }
+                for j in 1..corners.len() - 1 {
+                    triangles.push(([corners[0], corners[j], corners[j + 1]], line));
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok((vertices, triangles))
+}
+
+/// ASCII STL: `solid`, then per facet `facet normal nx ny nz`, `outer loop`, three
+/// `vertex x y z`, `endloop`, `endfacet`; `endsolid`. A facet with another number of corners,
+/// a line out of place or a token too many is an error naming its line.
+fn read_ascii_stl(
+    text: &str,
+    at: &dyn Fn(usize, String) -> String,
+) -> Result<(Vec<Vector3<Real>>, Lined), String> {
+    let mut vertices = Vec::new();
+    let mut merged = HashMap::new();
+    let mut triangles = Vec::new();
+    // The open facet: its first line and its corners so far.
+    let mut facet: Option<(usize, Vec<usize>)> = None;
+    let mut in_loop = false;
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let words: Vec<&str> = raw.split_whitespace().collect();
+        let Some(&keyword) = words.first() else {
+            continue;
+        };
+        let expect = |n: usize, form: &str| {
+            if words.len() == n {
+                Ok(())
+            } else {
+                Err(at(
+                    line,
+                    format!(
+                        "`{}` has {} words: write it as `{form}`",
+                        raw.trim(),
+                        words.len()
+                    ),
+                ))
+            }
+        };
+        match (keyword, facet.is_some(), in_loop) {
+            ("solid", false, _) | ("endsolid", false, _) => {}
+            ("facet", false, _) => {
+                expect(5, "facet normal nx ny nz")?;
+                if words[1] != "normal" {
+                    return Err(at(line, "write `facet normal nx ny nz`".to_string()));
+                }
+                // The normal is ignored (the corners' order gives the side) but must be numbers.
+                for w in &words[2..] {
+                    w.parse::<Real>()
+                        .map_err(|_| at(line, format!("the normal's {w:?} is not a number")))?;
+                }
+                facet = Some((line, Vec::new()));
+            }
+            ("outer", true, false) => {
+                expect(2, "outer loop")?;
+                in_loop = true;
+            }
+            ("vertex", true, true) => {
+                expect(4, "vertex x y z")?;
+                let p = Vector3::new(
+                    coordinate(line, words[1], at)?,
+                    coordinate(line, words[2], at)?,
+                    coordinate(line, words[3], at)?,
+                );
+                let corner = merge_vertex(&mut vertices, &mut merged, p);
+                if let Some((_, corners)) = facet.as_mut() {
+                    corners.push(corner);
+                }
+            }
+            ("endloop", true, true) => {
+                expect(1, "endloop")?;
+                in_loop = false;
+            }
+            ("endfacet", true, false) => {
+                expect(1, "endfacet")?;
+                if let Some((first, corners)) = facet.take() {
+                    if corners.len() != 3 {
+                        return Err(at(
+                            first,
+                            format!(
+                                "the facet has {} vertices (lines {first}-{line}): an STL facet is a triangle of exactly 3",
+                                corners.len()
+                            ),
+                        ));
+                    }
+                    triangles.push(([corners[0], corners[1], corners[2]], first));
+                }
+            }
+            (other, open, looping) => {
+                let wanted = match (open, looping) {
+                    (false, _) => "`facet normal ...` or `endsolid`",
+                    (true, false) => "`outer loop` or `endfacet`",
+                    (true, true) => "`vertex x y z` or `endloop`",
+                };
+                return Err(at(
+                    line,
+                    format!("`{other}` is out of place in an ASCII STL: expected {wanted}"),
+                ));
+            }
+        }
+    }
+    if let Some((first, _)) = facet {
+        return Err(at(
+            first,
+            "the facet starting here is not closed by `endfacet`: the file is cut short"
+                .to_string(),
+        ));
+    }
+    Ok((vertices, triangles))
+}
+
+/// The first triangle (0-based) that has no area, and why: a repeated corner, or corners on
+/// one line (within 1e-12 of its longest edge squared).
+pub(crate) fn degenerate(
+    vertices: &[Vector3<Real>],
+    triangles: &[[usize; 3]],
+) -> Option<(usize, String)> {
+    triangles.iter().enumerate().find_map(|(t, c)| {
+        if c[0] == c[1] || c[1] == c[2] || c[0] == c[2] {
+            return Some((
+                t,
+                format!(
+                    "face {} repeats a corner (vertices {}, {}, {})",
+                    t + 1,
+                    c[0] + 1,
+                    c[1] + 1,
+                    c[2] + 1
+                ),
+            ));
+        }
+        let [a, b, d] = c.map(|i| vertices[i]);
+        let longest = [
+            (b - a).norm_squared(),
+            (d - b).norm_squared(),
+            (a - d).norm_squared(),
+        ]
+        .into_iter()
+        .fold(0.0, Real::max);
+        ((b - a).cross(&(d - a)).norm() <= 1e-12 * longest).then(|| {
+            (
+                t,
+                format!(
+                    "face {} has zero area (its corners {}, {}, {} lie on one line)",
+                    t + 1,
+                    c[0] + 1,
+                    c[1] + 1,
+                    c[2] + 1
+                ),
+            )
+        })
+    })
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 
 use crate::contact::{mesh_collider, orient_outward, ContactSettings, Obstacle, ObstacleShape};
 use crate::linkage::{Body, Dimension, Schedule};
+use crate::scene::bounds::{check_length, check_lengths, check_rotation};
 use crate::scene::mesh_file::read_mesh;
 use crate::scene::selector::vector;
 use crate::scene::spec::{ContactSpec, ObstacleSpec};
@@ -10,7 +11,8 @@ use crate::Real;
 use nalgebra::Vector3;
 use std::path::Path;
 
-/// The obstacle described by `spec` in a scene of `dimension` with `steps` steps. Errors say
+/// The obstacle described by `spec` in a scene of `dimension` with `steps` steps, and what
+/// building it changed that the user may want to know (mesh faces turned outward). Errors say
 /// what is wrong and what to do (the caller adds the file and line).
 pub(crate) fn obstacle_from(
     spec: &ObstacleSpec,
@@ -18,7 +20,8 @@ pub(crate) fn obstacle_from(
     steps: usize,
     bodies: &[Body],
     folder: &Path,
-) -> Result<Obstacle, String> {
+) -> Result<(Obstacle, Option<String>), String> {
+    let mut found = None;
     let name = &spec.name;
     let fail = |m: String| format!("obstacle '{name}': {m}");
     if name.trim().is_empty() {
@@ -35,13 +38,15 @@ pub(crate) fn obstacle_from(
     }
     let point = |v: &Option<Vec<Real>>, key: &str| -> Result<Vector3<Real>, String> {
         match v {
-            Some(v) => vector(v, dimension, key).map_err(fail),
+            Some(v) => vector(v, dimension, key)
+                .and_then(|p| check_lengths(&p, key))
+                .map_err(fail),
             None => Err(fail(format!("a {} needs `{key}`", spec.shape))),
         }
     };
     let positive = |v: Option<Real>, key: &str| -> Result<Real, String> {
         match v {
-            Some(x) if x.is_finite() && x > 0.0 => Ok(x),
+            Some(x) if x.is_finite() && x > 0.0 => check_length(x, key).map_err(fail),
             Some(x) => Err(fail(format!("`{key}` = {x}: give a length > 0 (m)"))),
             None => Err(fail(format!("a {} needs `{key}` (m)", spec.shape))),
         }
@@ -58,9 +63,7 @@ pub(crate) fn obstacle_from(
                 )))
             }
         };
-        if !degrees.iter().all(|x| x.is_finite()) {
-            return Err(fail("`rotation` is not finite".to_string()));
-        }
+        check_rotation(&degrees, "rotation").map_err(fail)?;
         Ok(degrees.map(|x| x.to_radians()))
     };
     let shape = match spec.shape.as_str() {
@@ -121,12 +124,15 @@ pub(crate) fn obstacle_from(
                 ));
             };
             let path = folder.join(file);
-            let (vertices, triangles) = read_mesh(&path)?;
+            // Named with the `file` key, so that the scene line given is that key's.
+            let (vertices, triangles) =
+                read_mesh(&path).map_err(|e| fail(format!("`file`: {e}")))?;
             // Turned outward as a whole (faces that disagree with their neighbours turned too),
             // as body patches are: contact pushes nodes out along the faces' normals.
-            let triangles = orient_outward(&vertices, &triangles)
-                .map_err(|p| fail(format!("{}: {p}", path.display())))?
-                .triangles;
+            let oriented = orient_outward(&vertices, &triangles)
+                .map_err(|p| fail(format!("`file`: {}: {p}", path.display())))?;
+            found = turned_faces(name, &path, &oriented.turned, triangles.len());
+            let triangles = oriented.triangles;
             let _checked = mesh_collider(&vertices, &triangles).map_err(&fail)?;
             ObstacleShape::Mesh {
                 vertices,
@@ -140,7 +146,9 @@ pub(crate) fn obstacle_from(
         }
     };
     let travel = match &spec.travel {
-        Some(t) => vector(t, dimension, "travel").map_err(fail)?,
+        Some(t) => vector(t, dimension, "travel")
+            .and_then(|t| check_lengths(&t, "travel"))
+            .map_err(fail)?,
         None => Vector3::zeros(),
     };
     let schedule = match &spec.schedule {
@@ -154,14 +162,48 @@ pub(crate) fn obstacle_from(
         Some(f) if f.iter().any(|x| !x.is_finite()) => {
             return Err(fail("`schedule` has a non-finite factor".to_string()))
         }
-        Some(f) => Schedule::Factors(f.clone()),
+        Some(f) => {
+            // The offset of a step is the travel times its factor: that too must stay a length.
+            let most = f.iter().fold(0.0, |m: Real, x| m.max(x.abs()));
+            check_length(travel.amax() * most, "travel").map_err(|e| {
+                fail(format!(
+                    "{e} (the travel times the largest `schedule` factor, {most})"
+                ))
+            })?;
+            Schedule::Factors(f.clone())
+        }
     };
-    Ok(Obstacle {
-        name: name.clone(),
-        shape,
-        travel,
-        schedule,
-    })
+    Ok((
+        Obstacle {
+            name: name.clone(),
+            shape,
+            travel,
+            schedule,
+        },
+        found,
+    ))
+}
+
+/// What `linkage check` says of a mesh whose faces were turned (1-based `turned` of `count`):
+/// all of them (the mesh faced inward) or some (they disagreed with their neighbours).
+fn turned_faces(name: &str, path: &Path, turned: &[usize], count: usize) -> Option<String> {
+    if turned.is_empty() {
+        return None;
+    }
+    let file = path.display();
+    if turned.len() == count {
+        return Some(format!(
+            "obstacle '{name}': all {count} faces of {file} faced inward (clockwise seen from outside): turned outward as a whole"
+        ));
+    }
+    let listed: Vec<String> = turned.iter().take(20).map(|f| f.to_string()).collect();
+    Some(format!(
+        "obstacle '{name}': {} of the {count} faces of {file} disagreed with their neighbours or faced inward and were turned outward: face{} {}{}",
+        turned.len(),
+        if turned.len() == 1 { "" } else { "s" },
+        listed.join(", "),
+        if turned.len() > 20 { ", ..." } else { "" }
+    ))
 }
 
 /// The shape keys each obstacle shape takes (`travel` and `schedule` go with every shape).

@@ -5,10 +5,12 @@
 
 use crate::linkage::{check_members, Dimension, MemberProblem};
 use crate::scene::atomic_file::write_atomically;
+use crate::scene::link_lines;
 use crate::Real;
 use nalgebra::Vector3;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// A problem in one of the paper's files, with the file's path and, when it is about one
 /// line, its 1-based line number. The message says what is wrong and how to fix it.
@@ -41,8 +43,9 @@ pub struct LinkRecord {
     pub line: usize,
     /// Its end nodes, 0-based.
     pub nodes: [usize; 2],
-    /// The material named in the third column, if any.
-    pub material: Option<String>,
+    /// The material named in the third column, if any (shared by every record naming it: a
+    /// links file names few materials on millions of lines).
+    pub material: Option<Arc<str>>,
 }
 
 /// Parse the text of a nodes file: the dimension (2D for `x y` lines, 3D for `x y z`) and the
@@ -109,30 +112,7 @@ pub fn parse_links(
     path: &Path,
     nodes: &[Vector3<Real>],
 ) -> Result<Vec<LinkRecord>, PaperFileError> {
-    let mut records = Vec::new();
-    for item in data_lines(text, path) {
-        let (line, columns) = item?;
-        let count = columns.count;
-        if !(2..=3).contains(&count) {
-            return Err(line_error(
-                path,
-                line,
-                format!(
-                    "expected 2 node numbers and an optional material name \
-                     (`i j` or `i j material`), found {count} columns"
-                ),
-            ));
-        }
-        let [i, j, material] = columns.first;
-        records.push(LinkRecord {
-            line,
-            nodes: [
-                node_number(i, nodes.len(), path, line)?,
-                node_number(j, nodes.len(), path, line)?,
-            ],
-            material: (count == 3).then(|| material.to_string()),
-        });
-    }
+    let records = link_lines::parse(text, path, nodes.len())?;
     if records.is_empty() {
         return Err(file_error(
             path,
@@ -144,6 +124,49 @@ pub fn parse_links(
     check_members(nodes, records.iter().map(|r| r.nodes))
         .map_err(|problem| member_error(problem, &records, nodes.len(), path))?;
     Ok(records)
+}
+
+/// The member of one data line of a links file (`line`, 1-based, with its `columns`), its
+/// material shared through `names`: every check of a line and its message.
+pub(crate) fn link_record(
+    line: usize,
+    columns: &Columns,
+    names: &mut Vec<Arc<str>>,
+    path: &Path,
+    node_count: usize,
+) -> Result<LinkRecord, PaperFileError> {
+    let count = columns.count;
+    if !(2..=3).contains(&count) {
+        return Err(line_error(
+            path,
+            line,
+            format!(
+                "expected 2 node numbers and an optional material name \
+                 (`i j` or `i j material`), found {count} columns"
+            ),
+        ));
+    }
+    let [i, j, material] = columns.first;
+    Ok(LinkRecord {
+        line,
+        nodes: [
+            node_number(i, node_count, path, line)?,
+            node_number(j, node_count, path, line)?,
+        ],
+        material: (count == 3).then(|| shared_name(names, material)),
+    })
+}
+
+/// `name` as held in `names`, added if new.
+pub(crate) fn shared_name(names: &mut Vec<Arc<str>>, name: &str) -> Arc<str> {
+    match names.iter().find(|n| &***n == name) {
+        Some(shared) => shared.clone(),
+        None => {
+            let shared: Arc<str> = name.into();
+            names.push(shared.clone());
+            shared
+        }
+    }
 }
 
 /// Read a links file: see [`parse_links`].
@@ -287,15 +310,17 @@ pub fn write_patches(path: &Path, patches: &[[usize; 3]]) -> std::io::Result<()>
 }
 
 /// The whitespace-separated columns of one data line: how many, and the first three.
-struct Columns<'a> {
-    count: usize,
-    first: [&'a str; 3],
+pub(crate) struct Columns<'a> {
+    /// How many columns the line has.
+    pub(crate) count: usize,
+    /// The first three of them.
+    pub(crate) first: [&'a str; 3],
 }
 
 /// The data lines of `text` with their 1-based line numbers: comments stripped, blank lines
 /// skipped, a comma reported as an error (it would otherwise surface as a puzzling
 /// "not a number").
-fn data_lines<'a>(
+pub(crate) fn data_lines<'a>(
     text: &'a str,
     path: &'a Path,
 ) -> impl Iterator<Item = Result<(usize, Columns<'a>), PaperFileError>> + 'a {
@@ -303,28 +328,90 @@ fn data_lines<'a>(
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     text.lines().enumerate().filter_map(move |(index, raw)| {
         let line = index + 1;
-        let content = raw.split('#').next().unwrap_or_default();
-        if content.contains(',') {
-            return Some(Err(line_error(
-                path,
-                line,
-                "found a comma: separate the columns with spaces or tabs, not commas \
-                 (and write decimals with a point: 0.5)"
-                    .to_string(),
-            )));
-        }
-        let mut columns = Columns {
-            count: 0,
-            first: [""; 3],
+        let columns = if raw.is_ascii() {
+            ascii_columns(raw)
+        } else {
+            text_columns(raw)
         };
-        for token in content.split_whitespace() {
-            if let Some(slot) = columns.first.get_mut(columns.count) {
-                *slot = token;
-            }
-            columns.count += 1;
+        match columns {
+            Some(columns) => (columns.count > 0).then_some(Ok((line, columns))),
+            None => Some(Err(comma_error(path, line))),
         }
-        (columns.count > 0).then_some(Ok((line, columns)))
     })
+}
+
+/// The error of a line with a comma, which would otherwise surface as a puzzling "not a
+/// number".
+pub(crate) fn comma_error(path: &Path, line: usize) -> PaperFileError {
+    line_error(
+        path,
+        line,
+        "found a comma: separate the columns with spaces or tabs, not commas \
+         (and write decimals with a point: 0.5)"
+            .to_string(),
+    )
+}
+
+/// The columns of a line of any text: up to a `#`, split at Unicode whitespace; `None` if
+/// that part holds a comma.
+pub(crate) fn text_columns(raw: &str) -> Option<Columns<'_>> {
+    let content = raw.split('#').next().unwrap_or_default();
+    if content.contains(',') {
+        return None;
+    }
+    let mut columns = Columns {
+        count: 0,
+        first: [""; 3],
+    };
+    for token in content.split_whitespace() {
+        if let Some(slot) = columns.first.get_mut(columns.count) {
+            *slot = token;
+        }
+        columns.count += 1;
+    }
+    Some(columns)
+}
+
+/// [`text_columns`] of an ASCII line in one pass over its bytes (the files of large models
+/// are millions of such lines). ASCII whitespace here is what `char::is_whitespace` calls
+/// whitespace among ASCII characters, so both give the same columns.
+pub(crate) fn ascii_columns(raw: &str) -> Option<Columns<'_>> {
+    let bytes = raw.as_bytes();
+    let mut columns = Columns {
+        count: 0,
+        first: [""; 3],
+    };
+    let mut start = None;
+    let mut end = bytes.len();
+    for (k, &b) in bytes.iter().enumerate() {
+        match b {
+            b'#' => {
+                end = k;
+                break;
+            }
+            b',' => return None,
+            b' ' | b'\t' | b'\n' | b'\x0b' | b'\x0c' | b'\r' => {
+                if let Some(s) = start.take() {
+                    push_column(&mut columns, &raw[s..k]);
+                }
+            }
+            _ => {
+                start.get_or_insert(k);
+            }
+        }
+    }
+    if let Some(s) = start {
+        push_column(&mut columns, &raw[s..end]);
+    }
+    Some(columns)
+}
+
+/// Count a column, keeping the first three.
+fn push_column<'a>(columns: &mut Columns<'a>, token: &'a str) {
+    if let Some(slot) = columns.first.get_mut(columns.count) {
+        *slot = token;
+    }
+    columns.count += 1;
 }
 
 /// A coordinate, m: a finite number.
@@ -353,6 +440,16 @@ fn node_number(
     path: &Path,
     line: usize,
 ) -> Result<usize, PaperFileError> {
+    // Plain digits, the case of every valid line, without the general parse.
+    let bytes = token.as_bytes();
+    if !bytes.is_empty() && bytes.len() < 19 && bytes.iter().all(u8::is_ascii_digit) {
+        let n = bytes
+            .iter()
+            .fold(0usize, |n, &b| n * 10 + usize::from(b - b'0'));
+        if let Some(index) = n.checked_sub(1) {
+            return Ok(index);
+        }
+    }
     let error = |message: String| line_error(path, line, message);
     if let Ok(n) = token.parse::<usize>() {
         return match n.checked_sub(1) {
@@ -426,7 +523,7 @@ fn read_text(path: &Path) -> Result<String, PaperFileError> {
         .map_err(|e| file_error(path, format!("cannot read the file: {e}")))
 }
 
-fn line_error(path: &Path, line: usize, message: String) -> PaperFileError {
+pub(crate) fn line_error(path: &Path, line: usize, message: String) -> PaperFileError {
     PaperFileError::Line {
         path: path.to_path_buf(),
         line,
@@ -795,7 +892,7 @@ mod tests {
         assert_eq!(back.iter().map(|r| r.nodes).collect::<Vec<_>>(), members);
         assert_eq!(
             back.into_iter()
-                .map(|r| r.material.unwrap())
+                .map(|r| r.material.unwrap().to_string())
                 .collect::<Vec<_>>(),
             names
         );

@@ -2,6 +2,7 @@
 //! picture options of the scene file (the CLI's `--png` and `--vtk` switch them on too).
 
 use crate::scene::spec::OutputSpec;
+use crate::scene::vtu_arrays::VtkEncoding;
 use crate::Real;
 
 /// Pictures and VTK files a run writes (see `docs/SCENES.md`, `[output]`).
@@ -13,6 +14,8 @@ pub struct PictureSettings {
     pub gif: bool,
     /// Write `vtk/NNNN.vtu` per stored step and `vtk/<scene>.pvd`.
     pub vtk: bool,
+    /// How the `.vtu` files store their arrays (`[output] vtk_format`).
+    pub vtk_encoding: VtkEncoding,
     /// Frame width, pixels.
     pub width: u32,
     /// Frame height, pixels.
@@ -31,6 +34,7 @@ impl Default for PictureSettings {
             png: false,
             gif: false,
             vtk: false,
+            vtk_encoding: VtkEncoding::Binary,
             width: 1280,
             height: 720,
             magnification: None,
@@ -77,15 +81,49 @@ impl PictureSettings {
                 }
             }
         }
+        let vtk_encoding = match spec.vtk_format.as_deref() {
+            None => VtkEncoding::Binary,
+            Some(f) => VtkEncoding::parse(f).ok_or_else(|| {
+                format!("[output] vtk_format = {f:?}: use \"binary\" (compressed, the default) or \"ascii\"")
+            })?,
+        };
         Ok(PictureSettings {
             png,
             gif: spec.gif.unwrap_or(png),
             vtk: spec.vtk.unwrap_or(false),
+            vtk_encoding,
             width: side("width", spec.width, d.width)?,
             height: side("height", spec.height, d.height)?,
             magnification: spec.magnification,
             azimuth: spec.azimuth,
             elevation: spec.elevation,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vtk_format_is_binary_by_default_and_a_wrong_one_is_named() {
+        let spec = OutputSpec::default();
+        let s = PictureSettings::from_spec(&spec).unwrap();
+        assert_eq!(s.vtk_encoding, VtkEncoding::Binary);
+        let spec = OutputSpec {
+            vtk_format: Some("ascii".into()),
+            ..Default::default()
+        };
+        let s = PictureSettings::from_spec(&spec).unwrap();
+        assert_eq!(s.vtk_encoding, VtkEncoding::Ascii);
+        let spec = OutputSpec {
+            vtk_format: Some("xml".into()),
+            ..Default::default()
+        };
+        let e = PictureSettings::from_spec(&spec).unwrap_err();
+        assert!(
+            e.contains("vtk_format = \"xml\"") && e.contains("\"ascii\""),
+            "{e}"
+        );
     }
 }

@@ -3,6 +3,7 @@
 
 use crate::contact::{ContactSolver, NodeContact};
 use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
+use crate::scene::instability::InstabilityWatch;
 use crate::scene::results::{
     BodyResult, BodySize, ContactForce, PairForce, StepResult, StepSummary,
 };
@@ -26,6 +27,8 @@ pub struct Simulation<'w> {
     pub world: &'w World,
     /// The solvers of its bodies.
     pub solver: WorldSolver,
+    /// What the instability warnings remember of the previous step.
+    watch: InstabilityWatch,
 }
 
 impl<'w> Simulation<'w> {
@@ -50,7 +53,11 @@ impl<'w> Simulation<'w> {
                 })?;
             WorldSolver::Bodies(solvers)
         };
-        Ok(Simulation { world, solver })
+        Ok(Simulation {
+            world,
+            solver,
+            watch: InstabilityWatch::default(),
+        })
     }
 
     /// The contact solver, in a scene with contact.
@@ -76,6 +83,9 @@ impl<'w> Simulation<'w> {
                         source,
                     })?;
                 summary.iterations = solved.newton_iterations;
+                summary.cuts = solved.cuts;
+                summary.negative_pivots = solved.negative_pivots;
+                summary.linear_iterations = solved.linear_iterations;
                 summary.contact_iterations = solved.contact_iterations;
                 summary.max_penetration = solved.max_penetration;
                 summary.warnings = solved.warnings;
@@ -138,6 +148,10 @@ impl<'w> Simulation<'w> {
             }
             result.bodies.push(written);
         }
+        let warnings = self
+            .watch
+            .warnings(&world.bodies, step, &states, &summary.contact_forces);
+        summary.warnings.extend(warnings);
         Ok((result, summary))
     }
 
@@ -149,7 +163,7 @@ impl<'w> Simulation<'w> {
             .enumerate()
             .map(|(i, b)| {
                 let (free_dofs, solver) = match &self.solver {
-                    WorldSolver::Contact(c) => (c.free_dofs(i), "direct".to_string()),
+                    WorldSolver::Contact(c) => (c.free_dofs(i), c.solver_used(i).to_string()),
                     WorldSolver::Bodies(solvers) => {
                         solvers.get(i).map_or((0, String::new()), |s| {
                             (s.free_dofs(), s.solver_used().to_string())

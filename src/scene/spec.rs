@@ -374,6 +374,8 @@ pub struct OutputSpec {
     pub gif: Option<bool>,
     /// ParaView files.
     pub vtk: Option<bool>,
+    /// How ParaView files store their arrays: `"binary"` (default) or `"ascii"`.
+    pub vtk_format: Option<String>,
     /// Frame width, pixels.
     pub width: Option<u32>,
     /// Frame height, pixels.

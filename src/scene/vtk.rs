@@ -1,5 +1,5 @@
 //! ParaView files of a run's results: `vtk/NNNN.vtu` per stored step (VTK XML unstructured
-//! grid, ASCII) and `vtk/<scene>.pvd`, the collection ParaView plays as the deformation process.
+//! grid; arrays appended as zlib-compressed binary, or inline ASCII: [`VtkEncoding`]) and `vtk/<scene>.pvd`, the collection ParaView plays as the deformation process.
 //!
 //! One `.vtu` holds every body of the scene: points are the deformed node positions (z = 0
 //! for 2D bodies), body after body; cells are the members as lines (VTK_LINE = 3), in member
@@ -20,6 +20,7 @@ use crate::scene::atomic_file::write_atomically;
 use crate::scene::model_file::{ModelBody, ModelFile};
 use crate::scene::results::{BodyResult, StepResult};
 use crate::scene::run_results::RunResults;
+use crate::scene::vtu_arrays::{VtkEncoding, VtuArrays};
 use crate::Real;
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -53,7 +54,11 @@ pub enum VtkError {
 /// results folder (`DIR/<scene>`). The collection's `timestep` is the load factor when it
 /// grows strictly over the stored steps, else the step number (ParaView needs increasing
 /// times). Returns the files written.
-pub fn write_vtk(run: &RunResults, dir: &Path) -> Result<Vec<PathBuf>, VtkError> {
+pub fn write_vtk(
+    run: &RunResults,
+    dir: &Path,
+    encoding: VtkEncoding,
+) -> Result<Vec<PathBuf>, VtkError> {
     let results_dir = dir;
     let dir = results_dir.join("vtk");
     std::fs::create_dir_all(&dir).map_err(|source| VtkError::Write {
@@ -66,7 +71,7 @@ pub fn write_vtk(run: &RunResults, dir: &Path) -> Result<Vec<PathBuf>, VtkError>
         let step = result.step;
         let name = format!("{}.vtu", run.stem(step));
         let path = dir.join(&name);
-        write_atomically(&path, vtu_text(&run.model.bodies, result).as_bytes()).map_err(
+        write_atomically(&path, &vtu_file(&run.model.bodies, result, encoding)).map_err(
             |source| VtkError::Write {
                 path: path.clone(),
                 source,
@@ -79,14 +84,15 @@ pub fn write_vtk(run: &RunResults, dir: &Path) -> Result<Vec<PathBuf>, VtkError>
     if !run.model.obstacles.is_empty() {
         for result in &run.steps {
             let step = result.step;
-            let text =
-                obstacles_vtu_text(&run.model, step).map_err(|problem| VtkError::BadModel {
+            let file = obstacles_vtu_file(&run.model, step, encoding).map_err(|problem| {
+                VtkError::BadModel {
                     path: results_dir.join("model.json"),
                     problem,
-                })?;
+                }
+            })?;
             let name = format!("obstacles_{}.vtu", run.stem(step));
             let path = dir.join(&name);
-            write_atomically(&path, text.as_bytes()).map_err(|source| VtkError::Write {
+            write_atomically(&path, &file).map_err(|source| VtkError::Write {
                 path: path.clone(),
                 source,
             })?;
@@ -156,8 +162,12 @@ fn padded(p: &[Real]) -> [Real; 3] {
     ]
 }
 
-/// The text of one `.vtu` file for `result` of a run with model `bodies`.
-pub(crate) fn vtu_text(bodies: &[ModelBody], result: &StepResult) -> String {
+/// One `.vtu` file for `result` of a run with model `bodies`, its arrays in `encoding`.
+pub(crate) fn vtu_file(
+    bodies: &[ModelBody],
+    result: &StepResult,
+    encoding: VtkEncoding,
+) -> Vec<u8> {
     let mut points: Vec<[Real; 3]> = Vec::new();
     let mut displacement = Vec::new();
     let mut applied = Vec::new();
@@ -222,61 +232,65 @@ pub(crate) fn vtu_text(bodies: &[ModelBody], result: &StepResult) -> String {
     lines.extend(triangles);
     let cells = lines;
 
-    let mut s = String::with_capacity(64 * (points.len() + cells.len()) + 1024);
-    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n");
+    let mut a = VtuArrays::new(encoding, 64 * (points.len() + cells.len()) + 1024);
+    a.xml.push_str(&file_opening(encoding));
+    a.xml.push_str("  <UnstructuredGrid>\n");
     let _ = writeln!(
-        s,
+        a.xml,
         "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
         points.len(),
         cells.len()
     );
-    s.push_str("      <PointData Vectors=\"displacement\">\n");
-    vectors(&mut s, "displacement", &displacement);
-    vectors(&mut s, "applied_force", &applied);
-    vectors(&mut s, "reaction", &reaction);
-    vectors(&mut s, "contact_force", &contact);
-    ints(&mut s, "body", point_body.iter().copied());
-    s.push_str("      </PointData>\n      <CellData Scalars=\"stress\">\n");
-    scalars(&mut s, "axial_force", cells.iter().map(|c| c.axial_force));
-    scalars(&mut s, "stress", cells.iter().map(|c| c.stress));
-    ints(
-        &mut s,
-        "overloaded",
-        cells.iter().map(|c| c.overloaded as usize),
+    a.xml
+        .push_str("      <PointData Vectors=\"displacement\">\n");
+    a.vectors("displacement", &displacement);
+    a.vectors("applied_force", &applied);
+    a.vectors("reaction", &reaction);
+    a.vectors("contact_force", &contact);
+    a.ints("body", point_body.iter().copied());
+    a.xml
+        .push_str("      </PointData>\n      <CellData Scalars=\"stress\">\n");
+    a.scalars("axial_force", cells.iter().map(|c| c.axial_force));
+    a.scalars("stress", cells.iter().map(|c| c.stress));
+    a.ints("overloaded", cells.iter().map(|c| c.overloaded as usize));
+    a.ints("member", cells.iter().map(|c| c.member));
+    a.ints("body", cells.iter().map(|c| c.body));
+    a.xml.push_str("      </CellData>\n      <Points>\n");
+    a.vectors("Points", &points);
+    a.xml.push_str("      </Points>\n      <Cells>\n");
+    a.longs(
+        "connectivity",
+        cells.iter().flat_map(|c| c.points.iter().copied()),
     );
-    ints(&mut s, "member", cells.iter().map(|c| c.member));
-    ints(&mut s, "body", cells.iter().map(|c| c.body));
-    s.push_str("      </CellData>\n      <Points>\n");
-    vectors(&mut s, "Points", &points);
-    s.push_str("      </Points>\n      <Cells>\n");
-    array_open(&mut s, "Int64", "connectivity", 1);
-    for c in &cells {
-        for i in &c.points {
-            let _ = write!(s, "{i} ");
-        }
-    }
-    s.push_str("\n        </DataArray>\n");
-    array_open(&mut s, "Int64", "offsets", 1);
-    let mut offset = 0;
-    for c in &cells {
-        offset += c.points.len();
-        let _ = write!(s, "{offset} ");
-    }
-    s.push_str("\n        </DataArray>\n");
-    array_open(&mut s, "UInt8", "types", 1);
-    for c in &cells {
-        let _ = write!(s, "{} ", c.kind);
-    }
-    s.push_str(
-        "\n        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n",
+    a.longs(
+        "offsets",
+        cells.iter().scan(0, |offset, c| {
+            *offset += c.points.len();
+            Some(*offset)
+        }),
     );
-    s
+    a.bytes("types", cells.iter().map(|c| c.kind));
+    a.xml
+        .push_str("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n");
+    a.finish()
 }
 
-/// The text of `obstacles_NNNN.vtu` for `step`: every obstacle's surface moved by its
-/// offset at `step`; in a 2D scene (bodies of dimension 2) its cut by z = 0 as lines. Errors
-/// say what in `model.json` does not fit.
-pub(crate) fn obstacles_vtu_text(model: &ModelFile, step: usize) -> Result<String, String> {
+/// The XML declaration and the opening `VTKFile` element of an unstructured grid.
+fn file_opening(encoding: VtkEncoding) -> String {
+    format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\"{}>\n",
+        encoding.file_attributes()
+    )
+}
+
+/// `obstacles_NNNN.vtu` for `step`, arrays in `encoding`: every obstacle's surface moved by
+/// its offset at `step`; in a 2D scene (bodies of dimension 2) its cut by z = 0 as lines.
+/// Errors say what in `model.json` does not fit.
+pub(crate) fn obstacles_vtu_file(
+    model: &ModelFile,
+    step: usize,
+    encoding: VtkEncoding,
+) -> Result<Vec<u8>, String> {
     let two_d = model.bodies.first().is_some_and(|b| b.dimension == 2);
     let mut points: Vec<[Real; 3]> = Vec::new();
     let mut cells: Vec<(Vec<usize>, usize)> = Vec::new();
@@ -320,50 +334,45 @@ pub(crate) fn obstacles_vtu_text(model: &ModelFile, step: usize) -> Result<Strin
         }
     }
     let kind = if two_d { 3 } else { 5 };
-    let mut s = String::with_capacity(64 * (points.len() + cells.len()) + 1024);
-    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n    <FieldData>\n");
+    let mut a = VtuArrays::new(encoding, 64 * (points.len() + cells.len()) + 1024);
+    a.xml.push_str(&file_opening(encoding));
+    // Field data stays inline text in either encoding: one small number per obstacle.
+    a.xml.push_str("  <UnstructuredGrid>\n    <FieldData>\n");
     for (k, o) in model.obstacles.iter().enumerate() {
         let _ = writeln!(
-            s,
+            a.xml,
             "      <DataArray type=\"Int32\" Name=\"{}\" NumberOfTuples=\"1\" format=\"ascii\">{}</DataArray>",
             xml_attribute(&o.name),
             k + 1
         );
     }
-    s.push_str("    </FieldData>\n");
+    a.xml.push_str("    </FieldData>\n");
     let _ = writeln!(
-        s,
+        a.xml,
         "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
         points.len(),
         cells.len()
     );
-    s.push_str("      <CellData Scalars=\"obstacle\">\n");
-    ints(&mut s, "obstacle", cells.iter().map(|c| c.1));
-    s.push_str("      </CellData>\n      <Points>\n");
-    vectors(&mut s, "Points", &points);
-    s.push_str("      </Points>\n      <Cells>\n");
-    array_open(&mut s, "Int64", "connectivity", 1);
-    for (c, _) in &cells {
-        for i in c {
-            let _ = write!(s, "{i} ");
-        }
-    }
-    s.push_str("\n        </DataArray>\n");
-    array_open(&mut s, "Int64", "offsets", 1);
-    let mut offset = 0;
-    for (c, _) in &cells {
-        offset += c.len();
-        let _ = write!(s, "{offset} ");
-    }
-    s.push_str("\n        </DataArray>\n");
-    array_open(&mut s, "UInt8", "types", 1);
-    for _ in &cells {
-        let _ = write!(s, "{kind} ");
-    }
-    s.push_str(
-        "\n        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n",
+    a.xml.push_str("      <CellData Scalars=\"obstacle\">\n");
+    a.ints("obstacle", cells.iter().map(|c| c.1));
+    a.xml.push_str("      </CellData>\n      <Points>\n");
+    a.vectors("Points", &points);
+    a.xml.push_str("      </Points>\n      <Cells>\n");
+    a.longs(
+        "connectivity",
+        cells.iter().flat_map(|c| c.0.iter().copied()),
     );
-    Ok(s)
+    a.longs(
+        "offsets",
+        cells.iter().scan(0, |offset, c| {
+            *offset += c.0.len();
+            Some(*offset)
+        }),
+    );
+    a.bytes("types", cells.iter().map(|_| kind));
+    a.xml
+        .push_str("      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n");
+    Ok(a.finish())
 }
 
 /// `text` escaped for an XML attribute value.
@@ -390,37 +399,4 @@ fn overloaded_flags(m: &ModelBody, r: &BodyResult) -> Vec<u8> {
         }
     }
     f
-}
-
-/// Scalars (1 component) leave `NumberOfComponents` out, so readers give plain arrays.
-fn array_open(s: &mut String, ty: &str, name: &str, components: usize) {
-    let _ = write!(s, "        <DataArray type=\"{ty}\" Name=\"{name}\" ");
-    if components > 1 {
-        let _ = write!(s, "NumberOfComponents=\"{components}\" ");
-    }
-    s.push_str("format=\"ascii\">\n          ");
-}
-
-fn vectors(s: &mut String, name: &str, v: &[[Real; 3]]) {
-    array_open(s, "Float64", name, 3);
-    for p in v {
-        let _ = write!(s, "{:e} {:e} {:e} ", p[0], p[1], p[2]);
-    }
-    s.push_str("\n        </DataArray>\n");
-}
-
-fn scalars(s: &mut String, name: &str, v: impl Iterator<Item = Real>) {
-    array_open(s, "Float64", name, 1);
-    for x in v {
-        let _ = write!(s, "{x:e} ");
-    }
-    s.push_str("\n        </DataArray>\n");
-}
-
-fn ints(s: &mut String, name: &str, v: impl Iterator<Item = usize>) {
-    array_open(s, "Int32", name, 1);
-    for x in v {
-        let _ = write!(s, "{x} ");
-    }
-    s.push_str("\n        </DataArray>\n");
 }

@@ -42,6 +42,9 @@ pub struct World {
     pub bodies: Vec<Body>,
     /// Rigid obstacles (`[[obstacles]]`).
     pub obstacles: Vec<Obstacle>,
+    /// What building the world changed that a user may want to know (mesh faces turned
+    /// outward), as `linkage check` says it.
+    pub found: Vec<String>,
     /// Contact settings (`[contact]`).
     pub contact: ContactSettings,
     /// Whether the scene has a `[contact]` table (contact between its bodies is looked for).

@@ -103,7 +103,7 @@ pub(crate) fn write_after_steps(
         digits: step_digits(world.steps),
     };
     if world.pictures.vtk {
-        write_vtk(&run, dir).map_err(|e| RunError::Draw {
+        write_vtk(&run, dir, world.pictures.vtk_encoding).map_err(|e| RunError::Draw {
             path: dir.join("vtk"),
             source: Box::new(e),
         })?;

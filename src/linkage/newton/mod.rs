@@ -374,19 +374,22 @@ impl NewtonEquilibrium {
 /// halved after an increment fails, doubled again after two successes in a row (so a hard
 /// stretch of the path is crossed in small increments, and the rest of the step is not).
 #[derive(Clone, Copy, Debug, Default)]
-struct IncrementSize {
-    depth: usize,
+pub(crate) struct IncrementSize {
+    /// Halvings of the increment in force.
+    pub(crate) depth: usize,
     streak: usize,
     /// Halvings so far in this step.
-    cuts: usize,
+    pub(crate) cuts: usize,
 }
 
 impl IncrementSize {
-    fn fraction(&self) -> Real {
+    /// The increment as a fraction of a step.
+    pub(crate) fn fraction(&self) -> Real {
         0.5f64.powi(self.depth.min(1000) as i32)
     }
 
-    fn succeeded(&mut self) {
+    /// After a converged increment: double again after two in a row.
+    pub(crate) fn succeeded(&mut self) {
         self.streak += 1;
         if self.streak >= 2 && self.depth > 0 {
             self.depth -= 1;
@@ -395,7 +398,7 @@ impl IncrementSize {
     }
 
     /// Halve; false when that would go below `2^-max_cuts` of a step.
-    fn failed(&mut self, max_cuts: usize) -> bool {
+    pub(crate) fn failed(&mut self, max_cuts: usize) -> bool {
         self.streak = 0;
         if self.depth >= max_cuts {
             return false;

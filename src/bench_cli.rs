@@ -1,0 +1,198 @@
+//! The `linkage bench` commands: each runs one benchmark of `linkage::bench` and prints its
+//! table.
+
+use anyhow::{bail, Context, Result};
+use std::path::PathBuf;
+
+pub(crate) fn bench_contact(
+    cells: Vec<[usize; 3]>,
+    steps: Option<usize>,
+    direct: bool,
+) -> Result<()> {
+    let cells = cells.first().copied().unwrap_or([45, 45, 45]);
+    let solver = if direct { "direct" } else { "iterative" };
+    println!("3D box lattice on a fixed floor pressed 2 mm by a ball obstacle ({solver} solver)");
+    let t = linkage::bench::contact::measure_contact(cells, steps.unwrap_or(2), solver)
+        .map_err(anyhow::Error::msg)?;
+    for s in &t.steps {
+        println!("{}", linkage::bench::contact::format_step(s));
+    }
+    println!("{}", linkage::bench::contact::format_summary(&t));
+    Ok(())
+}
+
+pub(crate) fn bench_large(
+    cells: Vec<[usize; 3]>,
+    force: Option<f64>,
+    steps: Option<usize>,
+    iterative: bool,
+    cold: bool,
+) -> Result<()> {
+    use linkage::linkage::{SolverChoice, SolverSettings};
+    let cells = cells.first().copied().unwrap_or([16, 16, 150]);
+    let force = force.unwrap_or(2.5e5);
+    let steps = steps.unwrap_or(5);
+    let mut solver = SolverSettings {
+        choice: if iterative {
+            SolverChoice::Iterative
+        } else {
+            SolverChoice::Direct
+        },
+        ..Default::default()
+    };
+    solver.iterative.warm_start = !cold;
+    let how = match (iterative, cold) {
+        (false, _) => "sparse LLᵀ, METIS order, refactored every iteration",
+        (true, false) => "multigrid conjugate gradients, warm-started",
+        (true, true) => "multigrid conjugate gradients, cold starts",
+    };
+    println!("3D column lattice, bottom clamped, top pushed sideways; large displacements by Newton ({how})");
+    let t = linkage::bench::large::measure_large(cells, force, steps, solver)
+        .map_err(anyhow::Error::msg)?;
+    for s in &t.steps {
+        println!("{}", linkage::bench::large::format_step(s));
+    }
+    println!("{}", linkage::bench::large::format_summary(&t));
+    Ok(())
+}
+
+const DEFAULT_BENCH: [[usize; 3]; 6] = [
+    [10, 10, 10],
+    [20, 20, 20],
+    [20, 20, 40],
+    [30, 30, 30],
+    [40, 40, 40],
+    [43, 43, 43],
+];
+
+pub(crate) fn bench(
+    cells: Vec<[usize; 3]>,
+    iterative: bool,
+    jacobi: bool,
+    in_process: bool,
+) -> Result<()> {
+    let sizes = if cells.is_empty() {
+        DEFAULT_BENCH.to_vec()
+    } else {
+        cells
+    };
+    let what = if iterative && jacobi {
+        "block-Jacobi conjugate gradients to 1e-10"
+    } else if iterative {
+        "smoothed-aggregation multigrid conjugate gradients to 1e-10"
+    } else {
+        "direct sparse Cholesky (METIS order)"
+    };
+    println!("3D box lattices: 26-neighbour cells, bottom face fixed, top face loaded; {what}");
+    if iterative {
+        println!("{}", linkage::bench::lattice::ITERATIVE_HEADER);
+    } else {
+        println!("{}", linkage::bench::lattice::HEADER);
+    }
+    for c in sizes {
+        if in_process && iterative {
+            let t = linkage::bench::lattice::measure_iterative(c, !jacobi)
+                .map_err(anyhow::Error::msg)?;
+            println!("{}", linkage::bench::lattice::format_iterative_row(&t));
+        } else if in_process {
+            let t = linkage::bench::lattice::measure_lattice(c).map_err(anyhow::Error::msg)?;
+            println!("{}", linkage::bench::lattice::format_row(&t));
+        } else {
+            // One child per size, so the peak memory column is that size's own.
+            let exe = std::env::current_exe().context("cannot find the linkage executable")?;
+            let mut args = vec!["bench".to_string(), "--in-process".to_string()];
+            if iterative {
+                args.push("--iterative".to_string());
+            }
+            if jacobi {
+                args.push("--jacobi".to_string());
+            }
+            args.extend(["--cells".to_string(), format!("{}x{}x{}", c[0], c[1], c[2])]);
+            let output = std::process::Command::new(exe)
+                .args(&args)
+                .output()
+                .context("cannot start the benchmark child process")?;
+            if !output.status.success() {
+                bail!(
+                    "benchmark of {c:?} failed: {}",
+                    String::from_utf8_lossy(&output.stderr)
+                );
+            }
+            let text = String::from_utf8_lossy(&output.stdout);
+            if let Some(row) = text.lines().last() {
+                println!("{row}");
+            }
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn bench_read(cells: Vec<[usize; 3]>) -> Result<()> {
+    let dir = tempfile_dir("linkage-bench-read")?;
+    println!(
+        "Reading the paper's files of a box lattice (links with a material column), best of 3"
+    );
+    println!(
+        "{:>12} {:>8} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8}",
+        "cells",
+        "nodes",
+        "members",
+        "links MB",
+        "nodes s",
+        "links s",
+        "check s",
+        "patch s",
+        "Mlines/s"
+    );
+    let sizes = if cells.is_empty() {
+        vec![[49, 49, 49]]
+    } else {
+        cells
+    };
+    let measured = sizes.into_iter().try_for_each(|c| -> Result<()> {
+        let t = linkage::bench::read::measure_read(c, &dir, 3).map_err(anyhow::Error::msg)?;
+        println!(
+            "{:>12} {:>8} {:>9} {:>9.1} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.1}",
+            format!("{}x{}x{}", c[0], c[1], c[2]),
+            t.nodes,
+            t.members,
+            t.links_bytes as f64 / 1e6,
+            t.nodes_seconds,
+            t.links_seconds,
+            t.check_seconds,
+            t.patches_seconds,
+            t.members as f64 / t.links_seconds / 1e6
+        );
+        Ok(())
+    });
+    // The lattice's files are scratch: removed whether or not the measurement succeeded.
+    let _ = std::fs::remove_dir_all(&dir);
+    measured
+}
+
+/// A new empty folder under the system's temporary folder, named after `prefix` and this
+/// process.
+fn tempfile_dir(prefix: &str) -> Result<PathBuf> {
+    let dir = std::env::temp_dir().join(format!("{prefix}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    Ok(dir)
+}
+
+pub(crate) fn bench_render(patches: usize, size: [u32; 2]) -> Result<()> {
+    let t = linkage::bench::render::render_benchmark(patches, size[0], size[1], 3)
+        .map_err(anyhow::Error::msg)?;
+    println!("Rendering: one frame of a bent cylindrical shell, shaded and stress-coloured (supersampling 2x2), best of 3");
+    println!(
+        "{:>9} {:>9} {:>11} {:>10} {:>10}",
+        "patches", "members", "pixels", "draw s", "PNG s"
+    );
+    println!(
+        "{:>9} {:>9} {:>11} {:>10.3} {:>10.3}",
+        t.patches,
+        t.members,
+        format!("{}x{}", t.size[0], t.size[1]),
+        t.draw,
+        t.png
+    );
+    Ok(())
+}

@@ -1,0 +1,314 @@
+//! Crossing a contact step in increments: halved when Newton fails, doubled again after two successes, each started from the extrapolated path (the contact counterpart of a body's load control).
+//!
+//! A step goes from the last converged pseudo-time to the step's, with the loads, prescribed
+//! support displacements and obstacle offsets interpolated between steps. An increment that
+//! fails (Newton not converged, a state not finite, a tangent that cannot be factored) is
+//! undone: the displacements, the contact set and the normals go back to the last converged
+//! state, the condensed path (which solves whole steps only) gives way to the coupled one, and
+//! the increment is halved ([`IncrementSize`], as for a body). Only the converged end of the
+//! step is reported.
+
+use crate::contact::report::ContactStep;
+use crate::contact::settle::{newton_limits, Problem, PATH_POINTS};
+use crate::contact::{ActiveContact, ContactError, ContactSet, ContactSolver, Obstacle};
+use crate::linalg::CholeskyError;
+use crate::linkage::body_state::{loads_at, norm, prescribed_at};
+use crate::linkage::{Body, IncrementSize};
+use crate::Real;
+use nalgebra::Vector3;
+use std::collections::HashMap;
+use std::time::Instant;
+
+/// What an increment is undone to: the last converged state.
+struct Converged {
+    u: Vec<Vec<Real>>,
+    active: ContactSet,
+    normals: HashMap<ActiveContact, Vector3<Real>>,
+}
+
+impl ContactSolver {
+    /// Solve `step` of `steps` for `bodies` (the ones given to [`ContactSolver::new`]).
+    /// Steps are meant to come in order: each starts from the displacements and the contact
+    /// set of the step before (asking for step 0 starts over). A step Newton cannot cross at
+    /// once is crossed in halved increments (`cuts` in the result); it fails when an increment
+    /// of `1/2^max_cuts` of a step (the smallest `[bodies.newton] max_cuts`) still fails.
+    pub fn solve_step(
+        &mut self,
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        step: usize,
+        steps: usize,
+    ) -> Result<ContactStep, ContactError> {
+        let restart = step == 0 || step < self.step;
+        if restart {
+            for p in &mut self.parts {
+                p.u.iter_mut().for_each(|v| *v = 0.0);
+            }
+            self.active = ContactSet::default();
+            self.normals.clear();
+            self.path = vec![(0.0, self.parts.iter().map(|p| p.u.clone()).collect())];
+        }
+        if let Some(c) = self.condensed.as_mut() {
+            c.start_step(step, steps, restart);
+        }
+        let start = if restart { 0 } else { self.step };
+        self.step = step;
+        self.linear_before = self.coupled.linear_iterations();
+        let max_cuts = bodies.iter().map(|b| b.newton.max_cuts).min().unwrap_or(10);
+        let end = step as Real;
+        let mut t = start as Real;
+        let mut size = IncrementSize::default();
+        let mut out = ContactStep::default();
+        loop {
+            // The condensed path solves whole steps (its loads are per step); the coupled one
+            // crosses at most a step per increment.
+            let t1 = if self.condensed.is_some() || end - t <= size.fraction() * (1.0 + 1e-12) {
+                end
+            } else {
+                t + size.fraction()
+            };
+            let saved = self.converged_state();
+            // Every increment starts from the last converged state: the shells' sides too.
+            self.geometry
+                .record_sides(bodies, &self.parts, &self.active);
+            let offsets_there = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
+            self.geometry
+                .record_crossings(bodies, &self.parts, &self.active, offsets_there);
+            self.extrapolate(bodies, obstacles, t1, steps, step);
+            match self.settle(bodies, obstacles, t1, steps, step) {
+                Ok(done) => {
+                    out.contact_iterations += done.contact_iterations;
+                    out.newton_iterations += done.newton_iterations;
+                    out.stabilised |= done.stabilised;
+                    out.warnings.extend(done.warnings);
+                    if let Some(c) = self.condensed.as_mut() {
+                        c.solved(step);
+                    }
+                    if self.path.len() == PATH_POINTS {
+                        self.path.remove(0);
+                    }
+                    self.path
+                        .push((t1, self.parts.iter().map(|p| p.u.clone()).collect()));
+                    size.succeeded();
+                    t = t1;
+                    if t >= end {
+                        break;
+                    }
+                }
+                Err(e) if retried(&e) => {
+                    if let ContactError::NotConverged { history, .. } = &e {
+                        out.newton_iterations += history.len().saturating_sub(1);
+                    }
+                    self.restore(saved);
+                    self.leave_condensed()?;
+                    if !size.failed(max_cuts) {
+                        return Err(cut_to(e, step, &size));
+                    }
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        out.cuts = size.cuts;
+        self.report(bodies, obstacles, step, steps, out)
+    }
+
+    /// The state an increment starts from.
+    fn converged_state(&self) -> Converged {
+        Converged {
+            u: self.parts.iter().map(|p| p.u.clone()).collect(),
+            active: self.active.clone(),
+            normals: self.normals.clone(),
+        }
+    }
+
+    /// Undo a failed increment.
+    fn restore(&mut self, saved: Converged) {
+        for (p, u) in self.parts.iter_mut().zip(saved.u) {
+            p.u = u;
+        }
+        self.active = saved.active;
+        self.normals = saved.normals;
+        // Crossings found in the failed increment belong to a state that is gone.
+        self.geometry.forget_crossings_found();
+    }
+
+    /// Leave the condensed path (if on it) for the coupled solve of all bodies.
+    pub(crate) fn leave_condensed(&mut self) -> Result<(), ContactError> {
+        if self.condensed.take().is_some() {
+            let t = Instant::now();
+            self.coupled.rebuild(&self.parts)?;
+            self.times.symbolic += t.elapsed().as_secs_f64();
+        }
+        Ok(())
+    }
+
+    /// On the coupled path, move to the extrapolation at pseudo-time `t1` of the converged path
+    /// (a secant through the last two states, or a quadratic through the last three), supports
+    /// at their prescribed displacements, when its out-of-balance with the current contact set
+    /// is smaller than that of the current state with the supports moved. Returns whether it
+    /// moved. Newton iterates from there, so the answer is the same, only reached from closer.
+    fn extrapolate(
+        &mut self,
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        t1: Real,
+        steps: usize,
+        step: usize,
+    ) -> bool {
+        let n = self.path.len();
+        let current_is_newest = n >= 2
+            && self.path[n - 1]
+                .1
+                .iter()
+                .zip(&self.parts)
+                .all(|(u, p)| *u == p.u);
+        if self.condensed.is_some() || !current_is_newest {
+            return false;
+        }
+        let t = Instant::now();
+        let offsets: Vec<Vector3<Real>> =
+            obstacles.iter().map(|o| o.offset_at(t1, steps)).collect();
+        let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t1, steps)).collect();
+        for (part, body) in self.parts.iter_mut().zip(bodies) {
+            let prescribed = prescribed_at(body, t1, steps);
+            for &dof in &part.dofs.supported {
+                part.u[dof] = prescribed[dof];
+            }
+        }
+        let current: Vec<Vec<Real>> = self.parts.iter().map(|p| p.u.clone()).collect();
+        let mut best = self.out_of_balance_norm(bodies, &forces, &offsets, step);
+        let mut chosen = None;
+        for points in 2..=n {
+            let tail = &self.path[n - points..];
+            // Lagrange weights of the points at t1.
+            let weights: Vec<Real> = (0..points)
+                .map(|j| {
+                    (0..points)
+                        .filter(|&m| m != j)
+                        .map(|m| (t1 - tail[m].0) / (tail[j].0 - tail[m].0))
+                        .product()
+                })
+                .collect();
+            for (b, part) in self.parts.iter_mut().enumerate() {
+                for &dof in &part.dofs.free {
+                    part.u[dof] = tail
+                        .iter()
+                        .zip(&weights)
+                        .map(|(p, w)| w * p.1[b][dof])
+                        .sum();
+                }
+            }
+            let r = self.out_of_balance_norm(bodies, &forces, &offsets, step);
+            if r.is_finite() && r < best {
+                best = r;
+                chosen = Some(self.parts.iter().map(|p| p.u.clone()).collect::<Vec<_>>());
+            }
+        }
+        let moved = chosen.is_some();
+        for (p, u) in self.parts.iter_mut().zip(chosen.unwrap_or(current)) {
+            p.u = u;
+        }
+        self.times.assembly += t.elapsed().as_secs_f64();
+        moved
+    }
+
+    /// The norm of the coupled out-of-balance force at the current displacements with the
+    /// current contact set (its normals taken from a copy of the cache), N.
+    fn out_of_balance_norm(
+        &self,
+        bodies: &[Body],
+        forces: &[Vec<Real>],
+        offsets: &[Vector3<Real>],
+        step: usize,
+    ) -> Real {
+        let (tolerance, max_iterations) = newton_limits(bodies);
+        let problem = Problem {
+            bodies,
+            geometry: &self.geometry,
+            set: &self.active,
+            forces,
+            offsets,
+            step,
+            tolerance,
+            max_iterations,
+            move_cap: self.move_cap,
+            force_floor: self.force_floor(),
+        };
+        let mut normals = self.normals.clone();
+        let evaluated = problem.evaluate(&mut normals, &self.parts);
+        let (r, _) = self
+            .coupled
+            .out_of_balance(&problem, &self.parts, &evaluated);
+        norm(&r)
+    }
+}
+
+/// Whether a failed increment is retried with half the increment: Newton did not converge,
+/// the state is not finite, or the tangent could not be factored even stabilised.
+fn retried(e: &ContactError) -> bool {
+    matches!(
+        e,
+        ContactError::NotConverged { .. }
+            | ContactError::NotFinite { .. }
+            | ContactError::Factorization(
+                CholeskyError::NonPositivePivot { .. } | CholeskyError::NearlySingular { .. }
+            )
+    )
+}
+
+/// The error of step `step` after its smallest increment failed with `e`: how far it was cut.
+fn cut_to(e: ContactError, step: usize, size: &IncrementSize) -> ContactError {
+    let (reason, history) = match e {
+        ContactError::NotConverged {
+            reason, history, ..
+        } => (reason, history),
+        ContactError::NotFinite { .. } => (
+            "the solution is not finite (check the penalty and the loads)".to_string(),
+            Vec::new(),
+        ),
+        other => (other.to_string(), Vec::new()),
+    };
+    ContactError::NotConverged {
+        step,
+        depth: size.depth,
+        cuts: size.cuts,
+        reason,
+        history,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failures_newton_can_get_past_by_cutting_are_retried_and_report_the_depth() {
+        let failed = ContactError::NotConverged {
+            step: 3,
+            depth: 0,
+            cuts: 0,
+            reason: "no convergence in 4 Newton iterations".to_string(),
+            history: vec![1e-2, 1e-4],
+        };
+        assert!(retried(&failed));
+        assert!(retried(&ContactError::NotFinite { step: 3 }));
+        assert!(retried(&ContactError::Factorization(
+            CholeskyError::NonPositivePivot { dof: 0 }
+        )));
+        // A body no contact holds is not helped by smaller increments.
+        assert!(!retried(&ContactError::Unsupported {
+            step: 3,
+            body: "bar".to_string(),
+            iterations: 50,
+            contacts: 0,
+        }));
+        let mut size = IncrementSize::default();
+        assert!(size.failed(2) && size.failed(2) && !size.failed(2));
+        let message = cut_to(failed, 3, &size).to_string();
+        assert!(
+            message.starts_with("step 3: equilibrium with contact did not converge, even with its increment cut to 1/4 of the step (2 halvings deep, the most [bodies.newton] max_cuts allows; 2 halvings in this step in all"),
+            "{message}"
+        );
+        assert!(message.contains("no convergence in 4 Newton iterations; relative residuals of the last attempt: [1.0e-2, 1.0e-4]"), "{message}");
+    }
+}
