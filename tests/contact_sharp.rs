@@ -354,3 +354,48 @@ fn rotated_cuboid_edge_between_nodes_of_a_2d_block_still_presses() {
     eprintln!("2D between nodes: paths differ by {differ:.2e}");
     assert!(differ < 1e-7, "{differ:e}");
 }
+
+/// A cylinder (axis vertical) pressed 1 cm down on the block with its bottom rim exactly over
+/// four nodes of the top face (the midpoints of its edges, radius 0.1 about the face's centre):
+/// those nodes start on the rim and move into the cap, not through the side, so they are
+/// pressed down (the nearest point put them on the side: sideways forces), the block is pressed
+/// straight down, and the answer is mirror-symmetric in x and z on both paths.
+#[test]
+fn cylinder_rim_over_nodes_presses_them_down() {
+    let cylinder = "shape = \"cylinder\"\ncenter = [0.1, 0.125, 0.1]\nradius = 0.1\nhalf_height = 0.025\ntravel = [0.0, -0.01, 0.0]";
+    for steps in [1, 2] {
+        let scene =
+            block_scene([4, 2, 4], cylinder).replace("steps = 2", &format!("steps = {steps}"));
+        let (condensed, coupled, differ) = both(&[], &scene);
+        for body in [&condensed, &coupled] {
+            let f = total(body);
+            let (x, z) = (mirror_error(body, 0, 0.1), mirror_error(body, 2, 0.1));
+            eprintln!(
+                "cylinder: force {f:?}, sideways/vertical {:.2e}, mirror x {x:.2e} z {z:.2e}",
+                sideways_ratio(&f)
+            );
+            assert!(f[1] < -100.0, "{f:?}");
+            assert!(sideways_ratio(&f) < 1e-6, "{f:?}");
+            assert!(x < 1e-9 && z < 1e-9);
+            let mut rim = 0;
+            for c in &body.contacts {
+                let (p, u) = (&body.positions[c.node - 1], &body.displacements[c.node - 1]);
+                let o: Vec<f64> = p.iter().zip(u).map(|(p, u)| p - u).collect();
+                let r = ((o[0] - 0.1).powi(2) + (o[2] - 0.1).powi(2)).sqrt();
+                if (r - 0.1).abs() < 1e-9 && (o[1] - 0.1).abs() < 1e-9 {
+                    rim += 1;
+                    assert!(
+                        c.force[0].abs() + c.force[2].abs() <= 1e-9 * c.force[1].abs()
+                            && c.force[1] < 0.0,
+                        "rim node {} gets {:?}",
+                        c.node,
+                        c.force
+                    );
+                }
+            }
+            eprintln!("cylinder, {steps} steps: {rim} of the 4 nodes on the rim in contact");
+        }
+        eprintln!("cylinder: paths differ by {differ:.2e}");
+        assert!(differ < 1e-7, "{differ:e}");
+    }
+}

@@ -20,6 +20,7 @@ mod contact_set;
 mod coupled;
 mod coupled_iterative;
 mod coupled_system;
+mod cylinder_rim;
 mod detect;
 mod error;
 mod evaluate;

@@ -1,5 +1,6 @@
-//! Sharp features of polyhedral obstacles (cuboids, meshes): the face, edge or corner a node crossed since the last solved state, and the points sampled along sharp edges that press a coarse body's patches.
+//! Sharp features of polyhedral obstacles (cuboids, meshes) and cylinders' rims: the face, edge or corner a node crossed since the last solved state, and the points sampled along sharp edges that press a coarse body's patches.
 
+use crate::contact::cylinder_rim::CylinderRim;
 use crate::contact::obstacles::{from_glam, to_glam};
 use crate::contact::{ActiveContact, ContactSet, ObstacleShape, Target};
 use crate::Real;
@@ -250,10 +251,67 @@ impl Polyhedron {
     }
 }
 
+/// An obstacle with sharp features: polyhedral (a cuboid, a mesh) or a cylinder (its rims).
+pub(crate) enum SharpShape {
+    /// Triangles, their edges sharp where the faces turn by more than [`SHARP_ANGLE`].
+    Polyhedron(Polyhedron),
+    /// A cylinder: smooth side, flat caps, sharp rims.
+    Cylinder(CylinderRim),
+}
+
+impl SharpShape {
+    /// The sharp features of `shape`; `None` for the smooth shapes and a half-space.
+    pub(crate) fn of(shape: &ObstacleShape) -> Option<Self> {
+        match shape {
+            ObstacleShape::Cylinder {
+                center,
+                radius,
+                half_height,
+                rotation,
+            } => Some(SharpShape::Cylinder(CylinderRim::new(
+                *center,
+                *radius,
+                *half_height,
+                *rotation,
+            ))),
+            _ => Polyhedron::of(shape).map(SharpShape::Polyhedron),
+        }
+    }
+
+    /// See [`Polyhedron::crossing`] and [`CylinderRim::crossing`].
+    pub(crate) fn crossing(
+        &self,
+        from: &Vector3<Real>,
+        to: &Vector3<Real>,
+        tolerance: Real,
+    ) -> Option<Crossing> {
+        match self {
+            SharpShape::Polyhedron(p) => p.crossing(from, to, tolerance),
+            SharpShape::Cylinder(c) => c.crossing(from, to, tolerance),
+        }
+    }
+
+    /// Points along the sharp edges, at most `spacing` (m) apart.
+    pub(crate) fn sharp_points(&self, spacing: Real) -> Vec<Vector3<Real>> {
+        match self {
+            SharpShape::Polyhedron(p) => p.sharp_points(spacing),
+            SharpShape::Cylinder(c) => c.sharp_points(spacing),
+        }
+    }
+
+    /// Where the sharp edges cross z = 0.
+    pub(crate) fn section_corners(&self) -> Vec<Vector3<Real>> {
+        match self {
+            SharpShape::Polyhedron(p) => p.section_corners(),
+            SharpShape::Cylinder(c) => c.section_corners(),
+        }
+    }
+}
+
 /// The sharp features of every obstacle and the crossings of the nodes into them.
 pub(crate) struct Features {
-    /// Per obstacle, its triangles when it is polyhedral.
-    polyhedra: Vec<Option<Polyhedron>>,
+    /// Per obstacle, its sharp features (`None`: a smooth obstacle).
+    polyhedra: Vec<Option<SharpShape>>,
     /// Per obstacle, the points along its sharp edges at offset 0, m (2D: the corners of its
     /// section by z = 0).
     pub(crate) points: Vec<Vec<Vector3<Real>>>,
@@ -280,7 +338,7 @@ impl Features {
         shortest: Real,
         two_d: bool,
     ) -> Self {
-        let polyhedra: Vec<Option<Polyhedron>> = shapes.iter().map(|s| Polyhedron::of(s)).collect();
+        let polyhedra: Vec<Option<SharpShape>> = shapes.iter().map(|s| SharpShape::of(s)).collect();
         let points = polyhedra
             .iter()
             .map(|p| match p {
