@@ -100,7 +100,13 @@ impl CoupledIterative {
         let iterative: Vec<bool> = bodies
             .iter()
             .zip(assemblies)
-            .map(|(b, a)| b.solver.use_iterative(b.dimension.dofs_per_node(), a.n))
+            .map(|(b, a)| {
+                b.solver.use_iterative_in_contact(
+                    b.dimension.dofs_per_node(),
+                    a.n,
+                    !b.is_nonlinear(),
+                )
+            })
             .collect();
         if !iterative.iter().any(|&i| i) {
             return None;

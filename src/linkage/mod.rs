@@ -20,8 +20,8 @@ pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness
 pub(crate) use self::newton::IncrementSize;
 pub use self::newton::NewtonEquilibrium;
 pub use self::solver_choice::{
-    IterativeSettings, SolverChoice, SolverSettings, SolverUsed, AUTO_ITERATIVE_DOFS_2D,
-    AUTO_ITERATIVE_DOFS_3D,
+    IterativeSettings, SolverChoice, SolverSettings, SolverUsed, AUTO_CONTACT_ITERATIVE_DOFS_3D,
+    AUTO_ITERATIVE_DOFS_2D, AUTO_ITERATIVE_DOFS_3D,
 };
 pub(crate) use self::step_state::post_process;
 pub use self::step_state::StepState;

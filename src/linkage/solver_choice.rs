@@ -23,6 +23,14 @@ pub enum SolverChoice {
 /// linear run with several load schedules or a Newton run still favours it there.
 pub const AUTO_ITERATIVE_DOFS_3D: usize = 30_000;
 
+/// Free DOFs of a linear 3D body in a contact scene above which `auto` picks the iterative
+/// solver: below, the body is factored once per run and condensed on its contact candidates,
+/// and each contact step costs little; the coupled conjugate-gradient path instead solves at
+/// every Newton iteration (two 64,600-DOF boxes: 8 s of set-up and 0.5 s a step condensed,
+/// 41–144 s a step iteratively; a factorization of 86,000 DOFs takes 3.4 s, of 200,000 23 s
+/// and 2.7 GB: docs/PERFORMANCE.md).
+pub const AUTO_CONTACT_ITERATIVE_DOFS_3D: usize = 100_000;
+
 /// Free DOFs of a 2D body above which `auto` picks the iterative solver: plane linkages
 /// factor with little fill, so the direct solver stays ahead far longer.
 pub const AUTO_ITERATIVE_DOFS_2D: usize = 400_000;
@@ -78,6 +86,25 @@ impl SolverSettings {
     }
 }
 
+impl SolverSettings {
+    /// Whether a body in a contact scene is solved iteratively: as [`Self::use_iterative`],
+    /// but `auto` keeps a `linear` 3D body direct up to [`AUTO_CONTACT_ITERATIVE_DOFS_3D`]
+    /// free DOFs, where the condensed contact path is far ahead.
+    pub fn use_iterative_in_contact(
+        &self,
+        dimension: usize,
+        free_dofs: usize,
+        linear: bool,
+    ) -> bool {
+        match self.choice {
+            SolverChoice::Auto if linear && dimension == 3 => {
+                free_dofs > AUTO_CONTACT_ITERATIVE_DOFS_3D
+            }
+            _ => self.use_iterative(dimension, free_dofs),
+        }
+    }
+}
+
 /// The linear solver that produced a body's answers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SolverUsed {
@@ -109,5 +136,37 @@ impl fmt::Display for SolverUsed {
 impl PartialEq<&str> for SolverUsed {
     fn eq(&self, other: &&str) -> bool {
         self.as_str() == *other
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_keeps_a_linear_3d_body_in_contact_direct_longer() {
+        let auto = SolverSettings::default();
+        assert_eq!(auto.choice, SolverChoice::Auto);
+        let (below, between, above) = (
+            AUTO_ITERATIVE_DOFS_3D,
+            AUTO_ITERATIVE_DOFS_3D + 1,
+            AUTO_CONTACT_ITERATIVE_DOFS_3D + 1,
+        );
+        assert!(!auto.use_iterative(3, below) && auto.use_iterative(3, between));
+        assert!(!auto.use_iterative_in_contact(3, between, true));
+        assert!(auto.use_iterative_in_contact(3, above, true));
+        // A nonlinear body refactors every iteration anyway: the body rule holds.
+        assert!(auto.use_iterative_in_contact(3, between, false));
+        // What the scene says is what it gets.
+        let direct = SolverSettings {
+            choice: SolverChoice::Direct,
+            ..Default::default()
+        };
+        assert!(!direct.use_iterative_in_contact(3, above, true));
+        let iterative = SolverSettings {
+            choice: SolverChoice::Iterative,
+            ..Default::default()
+        };
+        assert!(iterative.use_iterative_in_contact(3, below, true));
     }
 }
