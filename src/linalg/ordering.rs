@@ -235,6 +235,13 @@ fn metis_node_nd(graph: &mut MetisGraph) -> Result<(Vec<idx_t>, Vec<idx_t>), Ord
     let mut nvtxs = idx_t::try_from(n).map_err(|_| too_large("vertices", n))?;
     let mut perm: Vec<idx_t> = vec![0; n];
     let mut iperm: Vec<idx_t> = vec![0; n];
+    // METIS draws its random choices from one process-wide generator, re-seeded at each call:
+    // two calls at once (bodies analysed side by side, scenes of a batch) would interleave
+    // its draws and each get another ordering than alone, so runs would differ in the last
+    // bits. One call at a time keeps every ordering the one it is alone. A poisoned lock only
+    // means another call panicked; the generator is re-seeded anyway.
+    static METIS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one_at_a_time = METIS.lock().unwrap_or_else(|e| e.into_inner());
     // SAFETY: `nvtxs` is the vertex count, `xadj` has `nvtxs + 1` offsets ending at
     // `adjncy.len()`, every neighbour is a valid vertex and the graph is symmetric
     // without self loops (all by construction of `MetisGraph`); `perm` and `iperm` hold

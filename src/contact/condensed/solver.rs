@@ -89,9 +89,20 @@ impl CondensedSolver {
         marks: Vec<Vec<bool>>,
         times: &mut PhaseTimes,
     ) -> (Option<Self>, Option<Box<Mechanism>>) {
+        // The bodies are condensed side by side: much of a body's set-up (its symbolic
+        // analysis, the factorization's many small supernodes) runs on one thread, so another
+        // body's work fills the other core. Each body's arithmetic is the same as alone (the
+        // METIS calls take turns, see `linalg::ordering`).
+        let results: Vec<Result<CondensedBody, CondenseFailure>> = bodies
+            .par_iter()
+            .zip(parts)
+            .zip(marks)
+            .map(|((body, part), mark)| CondensedBody::new(body, &part.dofs, &part.assembly, mark))
+            .collect();
         let mut built = Vec::with_capacity(bodies.len());
-        for ((body, part), mark) in bodies.iter().zip(parts).zip(marks) {
-            match CondensedBody::new(body, &part.dofs, &part.assembly, mark) {
+        // The first body (in order) that cannot be condensed decides, as one at a time did.
+        for (body, result) in bodies.iter().zip(results) {
+            match result {
                 Ok(c) => {
                     add_seconds(times, &c);
                     built.push(Condensation::new(c, body.dof_count()));
