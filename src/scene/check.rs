@@ -128,7 +128,7 @@ pub fn output_warning(world: &World) -> Option<String> {
         .max(1);
     let every = (world.steps as u64).div_ceil(room).max(2);
     Some(format!(
-        "the run would write about {:.1} GB ({stored} step files of about {} kB each, estimated from {} nodes and {} members{}): write fewer steps with [output] every = {every} or last_only = true, or use fewer load steps",
+        "the run would write about {:.1} GB ({stored} step files of about {} kB each, estimated from {} nodes and {} members{}): write fewer steps with [output] every = {every} or last_only = true, or use fewer load steps{}",
         total as f64 / 1e9,
         per_step.div_ceil(1000),
         world.bodies.iter().map(|b| b.nodes.len()).sum::<usize>(),
@@ -140,6 +140,10 @@ pub fn output_warning(world: &World) -> Option<String> {
             )
         } else {
             String::new()
+        },
+        match world.output.format {
+            ResultFormat::Json => ", or write them as NumPy arrays with [output] format = \"npz\" (2 to 3 times smaller)",
+            ResultFormat::Npz => "",
         },
     ))
 }

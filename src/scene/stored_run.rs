@@ -158,14 +158,12 @@ impl StoredRun {
                     path: dir.to_path_buf(),
                     problem: "holds neither model.json nor model.npz: it was written by an older linkage or is not a results folder".to_string(),
                 }),
-                Ok(_) => Err(StoredRunError::Read {
-                    path: dir.to_path_buf(),
-                    source: std::io::Error::other("not a folder"),
-                    hint: FOLDER_HINT,
-                }),
-                Err(source) => Err(StoredRunError::Read {
-                    path: dir.to_path_buf(),
-                    source,
+                // Not a folder: reading its model.json says why.
+                _ => Err(StoredRunError::Read {
+                    source: std::fs::read(&json).err().unwrap_or_else(|| {
+                        std::io::Error::other("model.json appeared while it was looked for")
+                    }),
+                    path: json,
                     hint: FOLDER_HINT,
                 }),
             },
