@@ -1,21 +1,66 @@
 //! `[output] format = "npz"`: the same results as JSON, to the last bit, read back by our readers
-//! and by NumPy; `linkage render` draws the same frames from either.
+//! and by NumPy; `linkage render` draws the same frames from either. The JSON compared with a
+//! run's `.npz` is made from the same results in memory, as the JSON writer makes it: two runs
+//! of a scene may differ in the last bits when threads share the solver's sums differently.
 //!
 //! The NumPy test uses the venv of tests/vtk.rs (`target/meshio-venv`: meshio brings numpy),
 //! made when missing; without python3 or PyPI it is skipped with a message.
 
-use linkage::scene::{build_world, load_scene, run, ResultFormat, RunResults, World};
+use linkage::scene::{
+    build_world, load_scene, run_with, DrawResults, ResultFormat, RunResults, World,
+};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::Mutex;
 
-/// `scene` loaded, written as `format` into `out/<format>/<name>`.
-fn run_as(scene: &str, format: ResultFormat, out: &Path) -> (World, PathBuf) {
+/// Keeps the run's results as they were in memory when its files were written.
+#[derive(Default)]
+struct Capture(Mutex<Option<RunResults>>);
+
+impl DrawResults for Capture {
+    fn draw(
+        &self,
+        _: &World,
+        run: &RunResults,
+        _: &Path,
+    ) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+        *self.0.lock().unwrap() = Some(run.clone());
+        Ok(())
+    }
+}
+
+/// `scene` loaded and run as `format` into `out/<format>/<name>`; the results in memory.
+fn run_as(scene: &str, format: ResultFormat, out: &Path) -> (World, PathBuf, RunResults) {
     let mut world = load_scene(Path::new(scene)).unwrap();
     world.output.format = format;
+    // Pictures asked for, so the results in memory reach the capture (which draws nothing).
+    world.pictures.png = true;
     let out = out.join(format.extension());
-    run(&world, &out, &|| {}).unwrap();
+    let capture = Capture::default();
+    run_with(&world, &out, &|| {}, Some(&capture)).unwrap();
     let dir = out.join(&world.name);
-    (world, dir)
+    let run = capture.0.into_inner().unwrap().unwrap();
+    (world, dir, run)
+}
+
+/// An `.npz` run of `scene` and the JSON folder of the same results (the solver's last bits
+/// may differ between two runs when threads share the work differently): `model.json` and
+/// `steps/NNNN.json` serialized as the JSON writer does (`serde_json::to_vec`), `summary.json`
+/// copied.
+fn npz_run_and_its_json(scene: &str, out: &Path) -> (World, PathBuf, PathBuf) {
+    let (world, npz, run) = run_as(scene, ResultFormat::Npz, out);
+    let json = out.join("twin").join(&world.name);
+    std::fs::create_dir_all(json.join("steps")).unwrap();
+    std::fs::copy(npz.join("summary.json"), json.join("summary.json")).unwrap();
+    let write = |f: &str, bytes: Vec<u8>| std::fs::write(json.join(f), bytes).unwrap();
+    write("model.json", serde_json::to_vec(&run.model).unwrap());
+    for step in &run.steps {
+        write(
+            &format!("steps/{}.json", run.stem(step.step)),
+            serde_json::to_vec(step).unwrap(),
+        );
+    }
+    (world, npz, json)
 }
 
 fn listing(dir: &Path) -> Vec<String> {
@@ -40,28 +85,31 @@ const SCENES: [&str; 3] = [
 ];
 
 #[test]
-fn npz_results_read_back_equal_to_the_json_results_bit_for_bit() {
+fn both_formats_read_back_equal_to_the_results_in_memory_bit_for_bit() {
     let out = tempfile::tempdir().unwrap();
     for scene in SCENES {
-        let (_, json) = run_as(scene, ResultFormat::Json, out.path());
-        let (world, npz) = run_as(scene, ResultFormat::Npz, out.path());
-        assert_eq!(listing(&npz), ["model.npz", "steps", "summary.json"]);
-        let steps = listing(&npz.join("steps"));
-        assert_eq!(steps.len(), world.steps + 1);
-        assert!(steps.iter().all(|s| s.ends_with(".npz")), "{steps:?}");
-        let from_json = RunResults::read(&json).unwrap();
-        let from_npz = RunResults::read(&npz).unwrap();
-        let (a, b) = (bits(&from_npz), bits(&from_json));
-        let first = a.split(", ").zip(b.split(", ")).find(|(x, y)| x != y);
-        assert!(a == b, "{scene}: npz {first:?} json");
-        if scene.contains("block") || scene.contains("disks") {
-            let contacts: usize = from_npz
-                .steps
-                .iter()
-                .flat_map(|s| &s.bodies)
-                .map(|b| b.contacts.len())
-                .sum();
-            assert!(contacts > 0, "{scene} has contacts to compare");
+        for format in [ResultFormat::Json, ResultFormat::Npz] {
+            let (world, dir, in_memory) = run_as(scene, format, out.path());
+            let ext = format.extension();
+            let mut files = listing(&dir);
+            files.retain(|f| f != "png" && f != "anim.gif");
+            assert_eq!(files, [format.model_file(), "steps", "summary.json"]);
+            let steps = listing(&dir.join("steps"));
+            assert_eq!(steps.len(), world.steps + 1);
+            assert!(steps.iter().all(|s| s.ends_with(ext)), "{steps:?}");
+            let read = RunResults::read(&dir).unwrap();
+            let (a, b) = (bits(&read), bits(&in_memory));
+            let first = a.split(", ").zip(b.split(", ")).find(|(x, y)| x != y);
+            assert!(a == b, "{scene} as {ext}: read {first:?} in memory");
+            if scene.contains("block") || scene.contains("disks") {
+                let contacts: usize = read
+                    .steps
+                    .iter()
+                    .flat_map(|s| &s.bodies)
+                    .map(|b| b.contacts.len())
+                    .sum();
+                assert!(contacts > 0, "{scene} has contacts to compare");
+            }
         }
     }
 }
@@ -166,8 +214,7 @@ fn numpy_reads_the_npz_steps_equal_to_the_json_steps_to_the_last_bit() {
     };
     let out = tempfile::tempdir().unwrap();
     for scene in SCENES {
-        let (_, json) = run_as(scene, ResultFormat::Json, out.path());
-        let (world, npz) = run_as(scene, ResultFormat::Npz, out.path());
+        let (world, npz, json) = npz_run_and_its_json(scene, out.path());
         for k in 0..=world.steps {
             let name = |ext: &str| format!("steps/{k:04}.{ext}");
             let o = Command::new(&python)
@@ -192,8 +239,8 @@ fn render_draws_the_same_frames_from_npz_as_from_json() {
     let out = tempfile::tempdir().unwrap();
     for scene in ["scenes/paper_overload.toml", "scenes/shell_on_block.toml"] {
         let mut frames = Vec::new();
-        for format in [ResultFormat::Json, ResultFormat::Npz] {
-            let (_, dir) = run_as(scene, format, out.path());
+        let (_, npz, json) = npz_run_and_its_json(scene, out.path());
+        for dir in [json, npz] {
             let o = Command::new(env!("CARGO_BIN_EXE_linkage"))
                 .arg("render")
                 .arg(&dir)
@@ -216,8 +263,7 @@ fn render_draws_the_same_frames_from_npz_as_from_json() {
 #[test]
 fn a_folder_with_both_models_or_a_torn_step_is_a_clear_error() {
     let out = tempfile::tempdir().unwrap();
-    let (_, npz) = run_as("scenes/paper_square.toml", ResultFormat::Npz, out.path());
-    let (_, json) = run_as("scenes/paper_square.toml", ResultFormat::Json, out.path());
+    let (_, npz, json) = npz_run_and_its_json("scenes/paper_square.toml", out.path());
 
     // A step file cut short: the file and the array are named.
     let step = npz.join("steps/0001.npz");

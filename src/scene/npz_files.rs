@@ -107,15 +107,15 @@ pub(crate) fn read_step_npz(bytes: &[u8], model: &ModelFile) -> Result<StepResul
     let step = npz.usizes("step")?.scalar("step")?;
     let load_factor = npz.f64s("load_factor")?.scalar("load_factor")?;
     let names = npz.strings("bodies")?.list("bodies", None)?;
+    if names.len() != model.bodies.len() {
+        return Err(format!(
+            "array 'bodies' lists {} bodies but the model has {}",
+            names.len(),
+            model.bodies.len()
+        ));
+    }
     let mut bodies = Vec::with_capacity(names.len());
-    for (k, name) in names.into_iter().enumerate() {
-        let model_body = model.bodies.get(k).ok_or_else(|| {
-            format!(
-                "has {} bodies but the model has {}",
-                k + 1,
-                model.bodies.len()
-            )
-        })?;
+    for (name, (k, model_body)) in names.into_iter().zip(model.bodies.iter().enumerate()) {
         let (n, m, d) = (
             model_body.nodes.len(),
             model_body.members.len(),
@@ -448,6 +448,12 @@ mod tests {
         let e = read_step_npz(&bytes, &model).unwrap_err();
         assert!(
             e.contains("array 'body1_displacements' has shape [2, 2]"),
+            "{e}"
+        );
+        model.bodies.pop();
+        let e = read_step_npz(&bytes, &model).unwrap_err();
+        assert!(
+            e.contains("array 'bodies' lists 2 bodies but the model has 1"),
             "{e}"
         );
         let e = read_step_npz(b"PK not really", &model).unwrap_err();
