@@ -11,7 +11,7 @@ use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
-use crate::scene::{OutputSettings, PictureSettings, World};
+use crate::scene::{OutputSettings, PictureSettings, ResultFormat, World};
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -165,6 +165,16 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
             None => 1,
         },
         last_only: spec.output.last_only,
+        format: ResultFormat::Json,
+    };
+    let format = match spec.output.format.as_deref() {
+        None => None,
+        Some(f) => Some(ResultFormat::parse(f).ok_or_else(|| {
+            at(
+                output_span.clone(),
+                format!("[output] format = {f:?}: use \"json\" or \"npz\" (NumPy arrays, for large models)"),
+            )
+        })?),
     };
     let pictures =
         PictureSettings::from_spec(&spec.output).map_err(|e| at(output_span.clone(), e))?;
@@ -228,6 +238,11 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         }
         obstacles.push(obstacle);
     }
+    let members = bodies.iter().map(|b| b.members.len()).sum();
+    let output = OutputSettings {
+        format: format.unwrap_or(ResultFormat::default_for(members)),
+        ..output
+    };
     Ok(World {
         obstacles,
         found,

@@ -4,7 +4,7 @@
 use crate::scene::results::BodySize;
 use crate::scene::run_error::RunError;
 use crate::scene::simulation::Simulation;
-use crate::scene::{OutputSettings, World};
+use crate::scene::{OutputSettings, ResultFormat, World};
 use std::path::PathBuf;
 
 /// A run that would write more step files than this, bytes, is warned about (1 GiB).
@@ -73,9 +73,17 @@ pub fn stored_steps(output: &OutputSettings, steps: usize) -> u64 {
     }
 }
 
+/// Bytes one value takes in a `.npz` step file (a raw `float64`).
+pub const NPZ_BYTES_PER_VALUE: u64 = 8;
+
 /// The bytes of one step file of `world`, estimated: per node its displacement and position,
-/// per member its axial force, strain and stress, [`BYTES_PER_VALUE`] each.
+/// per member its axial force, strain and stress, [`BYTES_PER_VALUE`] each as JSON,
+/// [`NPZ_BYTES_PER_VALUE`] as `.npz`.
 pub fn step_file_bytes(world: &World) -> u64 {
+    let per_value = match world.output.format {
+        ResultFormat::Json => BYTES_PER_VALUE,
+        ResultFormat::Npz => NPZ_BYTES_PER_VALUE,
+    };
     let values: u64 = world
         .bodies
         .iter()
@@ -84,7 +92,7 @@ pub fn step_file_bytes(world: &World) -> u64 {
             2 * d * b.nodes.len() as u64 + 3 * b.members.len() as u64
         })
         .sum();
-    values * BYTES_PER_VALUE
+    values * per_value
 }
 
 /// The bytes `model.json` takes for the obstacles' offsets, one per step 0..=steps and
@@ -120,7 +128,7 @@ pub fn output_warning(world: &World) -> Option<String> {
         .max(1);
     let every = (world.steps as u64).div_ceil(room).max(2);
     Some(format!(
-        "the run would write about {:.1} GB ({stored} step files of about {} kB each, estimated from {} nodes and {} members{}): write fewer steps with [output] every = {every} or last_only = true, or use fewer load steps",
+        "the run would write about {:.1} GB ({stored} step files of about {} kB each, estimated from {} nodes and {} members{}): write fewer steps with [output] every = {every} or last_only = true, or use fewer load steps{}",
         total as f64 / 1e9,
         per_step.div_ceil(1000),
         world.bodies.iter().map(|b| b.nodes.len()).sum::<usize>(),
@@ -133,6 +141,10 @@ pub fn output_warning(world: &World) -> Option<String> {
         } else {
             String::new()
         },
+        match world.output.format {
+            ResultFormat::Json => ", or write them as NumPy arrays with [output] format = \"npz\" (2 to 3 times smaller)",
+            ResultFormat::Npz => "",
+        },
     ))
 }
 
@@ -142,7 +154,11 @@ mod tests {
 
     #[test]
     fn stored_steps_count_step_zero_and_the_last() {
-        let every = |every, last_only| OutputSettings { every, last_only };
+        let every = |every, last_only| OutputSettings {
+            every,
+            last_only,
+            ..OutputSettings::default()
+        };
         assert_eq!(stored_steps(&every(1, false), 10), 11);
         assert_eq!(stored_steps(&every(3, false), 10), 5); // 0, 3, 6, 9, 10
         assert_eq!(stored_steps(&every(5, false), 10), 3); // 0, 5, 10

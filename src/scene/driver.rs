@@ -113,7 +113,7 @@ fn run_in(
         }
         if world.output.writes(step, world.steps) {
             let t = Instant::now();
-            kept.extend(write_step(&steps_dir, &result, digits, keep)?);
+            kept.extend(write_step(world, &steps_dir, result, digits, keep)?);
             summary.phases.writing += t.elapsed().as_secs_f64();
         }
         summary.steps.push(line);

@@ -3,11 +3,12 @@
 pub use self::build::{build_world, load_scene, SceneError};
 pub use self::check::{
     check_world, obstacle_offset_bytes, output_warning, step_file_bytes, stored_steps, CheckReport,
-    BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
+    BYTES_PER_VALUE, NPZ_BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
 };
 pub use self::driver::{run, run_until, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
+pub use self::result_format::{ResultFormat, NPZ_ABOVE_MEMBERS};
 pub use self::results::{
     BodyResult, BodySize, ContactForce, NodeForce, PairForce, PhaseSeconds, StepResult,
     StepSummary, Summary,
@@ -31,10 +32,13 @@ mod instability;
 mod link_lines;
 mod mesh_file;
 mod model_file;
+mod npz_archive;
+mod npz_files;
 mod obstacles;
 pub mod paper_files;
 mod pictures;
 pub mod publish;
+mod result_format;
 mod results;
 mod run_error;
 mod run_results;

@@ -17,6 +17,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 pub const WRITTEN: &[&str] = &[
     "summary.json",
     "model.json",
+    "model.npz",
     "steps",
     "vtk",
     "png",

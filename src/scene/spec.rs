@@ -368,6 +368,9 @@ pub struct OutputSpec {
     /// Write only the last step (and step 0).
     #[serde(default)]
     pub last_only: bool,
+    /// Step and model files: `"json"` or `"npz"` (default: JSON up to
+    /// [`crate::scene::NPZ_ABOVE_MEMBERS`] members, `.npz` above).
+    pub format: Option<String>,
     /// Pictures and VTK files: see [`crate::scene::PictureSettings`].
     pub png: Option<bool>,
     /// Animated GIF (default: as `png`).

@@ -1,7 +1,9 @@
-//! A results folder read back: `model.json` and the stored `steps/NNNN.json`, checked against
-//! each other, for drawing and exporting a run without solving it again.
+//! A results folder read back: `model.json` and the stored `steps/NNNN.json` (or `model.npz`
+//! and `steps/NNNN.npz`), checked against each other, for drawing and exporting a run without solving it again.
 
 use crate::scene::model_file::ModelFile;
+use crate::scene::npz_files::{read_model_npz, read_step_npz};
+use crate::scene::result_format::ResultFormat;
 use crate::scene::results::StepResult;
 use crate::scene::run_results::{step_stem, RunResults, MIN_STEP_DIGITS};
 use std::path::{Path, PathBuf};
@@ -40,6 +42,8 @@ pub struct StoredRun {
     pub dir: PathBuf,
     /// The undeformed model.
     pub model: ModelFile,
+    /// Whether the model and the steps are JSON or `.npz` files.
+    pub format: ResultFormat,
     /// Stored step numbers, ascending (step 0 first).
     pub steps: Vec<usize>,
     /// Digits of the step numbers in the step files' names (the most any has, at least 4):
@@ -50,20 +54,22 @@ pub struct StoredRun {
 }
 
 impl StoredRun {
-    /// Read `dir/model.json` and list `dir/steps/NNNN.json` (any number of digits from 4, as
-    /// many as the run's last step needs).
+    /// Read `dir/model.json` or `dir/model.npz` (whichever the folder holds: both or neither is
+    /// an error) and list the step files of the same format, `dir/steps/NNNN.json` or `.npz`
+    /// (any number of digits from 4, as many as the run's last step needs).
     pub fn open(dir: &Path) -> Result<Self, StoredRunError> {
-        let path = dir.join("model.json");
+        let format = Self::model_format(dir)?;
+        let path = dir.join(format.model_file());
         let bytes = std::fs::read(&path).map_err(|source| StoredRunError::Read {
-            hint: if dir.is_dir() {
-                "the folder was written by an older linkage or is not a results folder: run the scene again with `linkage run`"
-            } else {
-                FOLDER_HINT
-            },
+            hint: FOLDER_HINT,
             path: path.clone(),
             source,
         })?;
-        let model: ModelFile = serde_json::from_slice(&bytes).map_err(|e| StoredRunError::Bad {
+        let model: ModelFile = match format {
+            ResultFormat::Json => serde_json::from_slice(&bytes).map_err(|e| e.to_string()),
+            ResultFormat::Npz => read_model_npz(&bytes),
+        }
+        .map_err(|e| StoredRunError::Bad {
             path: path.clone(),
             problem: format!("not a model file ({e})"),
         })?;
@@ -76,6 +82,11 @@ impl StoredRun {
             source,
             hint: FOLDER_HINT,
         })?;
+        let ext = format.extension();
+        let other = match format {
+            ResultFormat::Json => ResultFormat::Npz,
+            ResultFormat::Npz => ResultFormat::Json,
+        };
         let mut found: Vec<(usize, String)> = Vec::new();
         for entry in entries {
             let entry = entry.map_err(|source| StoredRunError::Read {
@@ -84,12 +95,20 @@ impl StoredRun {
                 hint: FOLDER_HINT,
             })?;
             let name = entry.file_name().to_string_lossy().into_owned();
-            if let Some(stem) = name.strip_suffix(".json") {
-                if stem.len() >= MIN_STEP_DIGITS && stem.bytes().all(|b| b.is_ascii_digit()) {
-                    if let Ok(k) = stem.parse::<usize>() {
-                        found.push((k, name));
-                    }
+            for (e, ours) in [(ext, true), (other.extension(), false)] {
+                let Some(k) = step_number(&name, e) else {
+                    continue;
+                };
+                if !ours {
+                    return Err(StoredRunError::Bad {
+                        path: steps_dir,
+                        problem: format!(
+                            "holds {name}, but the run's model is {}: its step files are NNNN.{ext}",
+                            format.model_file()
+                        ),
+                    });
                 }
+                found.push((k, name.clone()));
             }
         }
         found.sort_unstable();
@@ -104,22 +123,51 @@ impl StoredRun {
         }
         let digits = found
             .iter()
-            .map(|(_, name)| name.len() - ".json".len())
+            .map(|(_, name)| name.len() - ext.len() - 1)
             .fold(MIN_STEP_DIGITS, usize::max);
         let (steps, files): (Vec<usize>, Vec<String>) = found.into_iter().unzip();
         if steps.is_empty() {
             return Err(StoredRunError::Bad {
                 path: steps_dir,
-                problem: "holds no step files (NNNN.json)".to_string(),
+                problem: format!("holds no step files (NNNN.{ext})"),
             });
         }
         Ok(StoredRun {
             dir: dir.to_path_buf(),
             model,
+            format,
             steps,
             digits,
             files,
         })
+    }
+
+    /// The format of the results in `dir`: the one whose model file it holds.
+    fn model_format(dir: &Path) -> Result<ResultFormat, StoredRunError> {
+        let json = dir.join(ResultFormat::Json.model_file());
+        let npz = dir.join(ResultFormat::Npz.model_file());
+        match (json.exists(), npz.exists()) {
+            (true, false) => Ok(ResultFormat::Json),
+            (false, true) => Ok(ResultFormat::Npz),
+            (true, true) => Err(StoredRunError::Bad {
+                path: dir.to_path_buf(),
+                problem: "holds both model.json and model.npz, so which results are the run's is not clear: remove the older".to_string(),
+            }),
+            (false, false) => match std::fs::metadata(dir) {
+                Ok(m) if m.is_dir() => Err(StoredRunError::Bad {
+                    path: dir.to_path_buf(),
+                    problem: "holds neither model.json nor model.npz: it was written by an older linkage or is not a results folder".to_string(),
+                }),
+                // Not a folder: reading its model.json says why.
+                _ => Err(StoredRunError::Read {
+                    source: std::fs::read(&json).err().unwrap_or_else(|| {
+                        std::io::Error::other("model.json appeared while it was looked for")
+                    }),
+                    path: json,
+                    hint: FOLDER_HINT,
+                }),
+            },
+        }
     }
 
     /// The file of stored step `step` (as it is named in the folder; a step not stored: the
@@ -127,7 +175,11 @@ impl StoredRun {
     pub fn step_path(&self, step: usize) -> PathBuf {
         let name = match self.steps.binary_search(&step) {
             Ok(i) => self.files[i].clone(),
-            Err(_) => format!("{}.json", step_stem(step, self.digits)),
+            Err(_) => format!(
+                "{}.{}",
+                step_stem(step, self.digits),
+                self.format.extension()
+            ),
         };
         self.dir.join("steps").join(name)
     }
@@ -140,11 +192,14 @@ impl StoredRun {
             source,
             hint: "the folder is incomplete",
         })?;
-        let result: StepResult =
-            serde_json::from_slice(&bytes).map_err(|e| StoredRunError::Bad {
-                path: path.clone(),
-                problem: format!("not a step file ({e})"),
-            })?;
+        let result: StepResult = match self.format {
+            ResultFormat::Json => serde_json::from_slice(&bytes).map_err(|e| e.to_string()),
+            ResultFormat::Npz => read_step_npz(&bytes, &self.model),
+        }
+        .map_err(|e| StoredRunError::Bad {
+            path: path.clone(),
+            problem: format!("not a step file ({e})"),
+        })?;
         if let Some(problem) = self.model.step_problem(&result) {
             return Err(StoredRunError::Bad { path, problem });
         }
@@ -169,6 +224,16 @@ impl StoredRun {
             steps,
             digits: self.digits,
         })
+    }
+}
+
+/// The step number of a step file's `name` with extension `ext` (`0042.json`: 42), if it is one.
+fn step_number(name: &str, ext: &str) -> Option<usize> {
+    let stem = name.strip_suffix(ext)?.strip_suffix('.')?;
+    if stem.len() >= MIN_STEP_DIGITS && stem.bytes().all(|b| b.is_ascii_digit()) {
+        stem.parse().ok()
+    } else {
+        None
     }
 }
 

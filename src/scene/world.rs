@@ -2,17 +2,19 @@
 
 use crate::contact::{ContactSettings, Obstacle};
 use crate::linkage::{Body, Schedule};
-use crate::scene::PictureSettings;
+use crate::scene::{PictureSettings, ResultFormat};
 use crate::Real;
 use std::path::PathBuf;
 
-/// Which stored steps are written to `steps/NNNN.json`.
+/// Which stored steps are written to `steps/NNNN.json` (or `.npz`), and in which format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OutputSettings {
     /// Write every k-th step (≥ 1).
     pub every: usize,
     /// Write only step 0 and the last step.
     pub last_only: bool,
+    /// JSON or NumPy `.npz` step and model files (`[output] format`).
+    pub format: ResultFormat,
 }
 
 impl Default for OutputSettings {
@@ -20,6 +22,7 @@ impl Default for OutputSettings {
         OutputSettings {
             every: 1,
             last_only: false,
+            format: ResultFormat::Json,
         }
     }
 }

@@ -1,14 +1,15 @@
-//! What a run writes, handed its results in memory: each step file as the step is solved, then
-//! `model.json`, VTK files and pictures into the staging folder before it is published.
+//! What a run writes, handed its results in memory: each step file (JSON or `.npz`) as the step
+//! is solved, then `model.json` (or `model.npz`), VTK files and pictures into the staging folder before it is published.
 
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::model_file::ModelFile;
+use crate::scene::npz_files::{model_npz, step_npz};
+use crate::scene::result_format::ResultFormat;
 use crate::scene::results::{PhaseSeconds, StepResult};
 use crate::scene::run_error::RunError;
 use crate::scene::run_results::{step_digits, step_stem, RunResults};
 use crate::scene::vtk::write_vtk;
 use crate::scene::World;
-use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::path::Path;
 use std::time::Instant;
@@ -54,34 +55,49 @@ pub(crate) fn write_json(
     Ok(bytes)
 }
 
-/// What a reader of the file `path` holding `bytes` (just written) gets. serde_json's default
-/// float parsing is not always correctly rounded (`0.12499999999999999` reads as `0.125`), so
-/// the writers after the loop take the numbers as the files give them, parsed from memory:
-/// the numbers `linkage render` reads, so pictures and VTK files do not depend on whether they
-/// were made during the run or from the folder afterwards.
-fn read_back<T: DeserializeOwned>(path: &Path, bytes: &[u8]) -> Result<T, RunError> {
-    serde_json::from_slice(bytes).map_err(|e| RunError::Write {
-        path: path.to_path_buf(),
-        source: e.into(),
-    })
-}
-
-/// Write `steps_dir/NNNN.json` of `result` (the step number padded to `digits`, see
-/// [`step_digits`]); with `keep`, return the step as the file gives it back (see
-/// [`read_back`]) for the writers after the loop.
+/// Write `steps_dir/NNNN.json` (or `.npz`, as `world.output.format` says) of `result` (the
+/// step number padded to `digits`, see [`step_digits`]); with `keep`, return it for the writers
+/// after the loop. Both formats give back exactly the numbers in memory (JSON: shortest
+/// round-trip digits, parsed by serde_json with `float_roundtrip`; `.npz`: the bits), so
+/// pictures and VTK files are the same whether made during the run or by `linkage render`.
 pub(crate) fn write_step(
+    world: &World,
     steps_dir: &Path,
-    result: &StepResult,
+    result: StepResult,
     digits: usize,
     keep: bool,
 ) -> Result<Option<StepResult>, RunError> {
-    let path = steps_dir.join(format!("{}.json", step_stem(result.step, digits)));
-    let bytes = write_json(&path, result, false)?;
-    keep.then(|| read_back(&path, &bytes)).transpose()
+    let format = world.output.format;
+    let name = format!("{}.{}", step_stem(result.step, digits), format.extension());
+    let path = steps_dir.join(name);
+    match format {
+        ResultFormat::Json => {
+            write_json(&path, &result, false)?;
+        }
+        ResultFormat::Npz => {
+            let dimensions: Vec<usize> = world
+                .bodies
+                .iter()
+                .map(|b| b.dimension.dofs_per_node())
+                .collect();
+            write_bytes(&path, step_npz(&result, &dimensions))?;
+        }
+    }
+    Ok(keep.then_some(result))
 }
 
-/// Write `model.json` of `world`, then VTK files and pictures as `world.pictures` asks, into
-/// `dir`, from the stored `steps` (kept when [`keeps_steps`] says they are needed).
+/// Write `bytes` (or the error of making them) to `path`, atomically.
+fn write_bytes(path: &Path, bytes: std::io::Result<Vec<u8>>) -> Result<(), RunError> {
+    let err = |source| RunError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    write_atomically(path, &bytes.map_err(err)?).map_err(err)
+}
+
+/// Write `model.json` (or `model.npz`) of `world`, then VTK files and pictures as
+/// `world.pictures` asks, into `dir`, from the stored `steps` (kept when [`keeps_steps`] says
+/// they are needed).
 pub(crate) fn write_after_steps(
     world: &World,
     steps: Vec<StepResult>,
@@ -90,15 +106,22 @@ pub(crate) fn write_after_steps(
     phases: &mut PhaseSeconds,
 ) -> Result<(), RunError> {
     let t = Instant::now();
-    let path = dir.join("model.json");
-    let bytes = write_json(&path, &ModelFile::new(world), false)?;
+    let format = world.output.format;
+    let path = dir.join(format.model_file());
+    let model = ModelFile::new(world);
+    match format {
+        ResultFormat::Json => {
+            write_json(&path, &model, false)?;
+        }
+        ResultFormat::Npz => write_bytes(&path, model_npz(&model))?,
+    }
     let drawing = draw.filter(|_| world.pictures.png || world.pictures.gif);
     if !world.pictures.vtk && drawing.is_none() {
         phases.writing += t.elapsed().as_secs_f64();
         return Ok(());
     }
     let run = RunResults {
-        model: read_back(&path, &bytes)?,
+        model,
         steps,
         digits: step_digits(world.steps),
     };
