@@ -6,6 +6,8 @@
 //! The NumPy test uses the venv of tests/vtk.rs (`target/meshio-venv`: meshio brings numpy),
 //! made when missing; without python3 or PyPI it is skipped with a message.
 
+mod common;
+
 use linkage::scene::{
     build_world, load_scene, run_with, DrawResults, ResultFormat, RunResults, World,
 };
@@ -114,47 +116,6 @@ fn both_formats_read_back_equal_to_the_results_in_memory_bit_for_bit() {
     }
 }
 
-/// A Python with numpy: the venv of tests/vtk.rs, made as that test makes it; `None` (with the
-/// reason) when it cannot be made here.
-fn numpy_python() -> Result<PathBuf, String> {
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/meshio-venv");
-    let python = venv.join("bin/python");
-    let has_numpy = |py: &Path| {
-        Command::new(py)
-            .args(["-c", "import numpy"])
-            .output()
-            .map(|o| o.status.success())
-            .unwrap_or(false)
-    };
-    if has_numpy(&python) {
-        return Ok(python);
-    }
-    let made = Command::new("python3")
-        .args(["-m", "venv"])
-        .arg(&venv)
-        .output()
-        .map_err(|e| format!("cannot run python3: {e}"))?;
-    if !made.status.success() {
-        return Err(format!(
-            "cannot create a venv at {}: {}",
-            venv.display(),
-            String::from_utf8_lossy(&made.stderr)
-        ));
-    }
-    let pip = Command::new(&python)
-        .args(["-m", "pip", "install", "--quiet", "meshio"])
-        .output()
-        .map_err(|e| format!("cannot run the venv's python: {e}"))?;
-    if pip.status.success() && has_numpy(&python) {
-        Ok(python)
-    } else {
-        Err(format!(
-            "cannot install meshio (and numpy) from PyPI: {}",
-            String::from_utf8_lossy(&pip.stderr)
-        ))
-    }
-}
-
 /// Compares every field of a step's `.npz` with its `.json`, bit for bit (floats as their
 /// int64 bit patterns, so -0.0 and 0.0 differ), shapes and dtypes included; prints the number
 /// of values compared.
@@ -205,7 +166,7 @@ print(count)
 
 #[test]
 fn numpy_reads_the_npz_steps_equal_to_the_json_steps_to_the_last_bit() {
-    let python = match numpy_python() {
+    let python = match common::python_with_meshio() {
         Ok(p) => p,
         Err(why) => {
             eprintln!("skipped: no Python with numpy ({why})");

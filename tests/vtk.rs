@@ -4,54 +4,17 @@
 //! meshio is installed on first use into a venv under `target/` (PyPI must be reachable);
 //! `.ci/run` installs it before the tests.
 
+mod common;
+
 use linkage::scene::{load_scene, run, StepResult};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// A Python with meshio: `target/meshio-venv`, created and filled when missing.
+/// A Python with meshio (see [`common::python_with_meshio`]); a test fails when it cannot be
+/// made.
 fn meshio_python() -> PathBuf {
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/meshio-venv");
-    let python = venv.join("bin/python");
-    let has_meshio = |py: &Path| {
-        Command::new(py)
-            .args(["-c", "import meshio"])
-            .output()
-            .map(|o| o.status.success())
-            .unwrap_or(false)
-    };
-    if has_meshio(&python) {
-        return python;
-    }
-    let made = Command::new("python3")
-        .args(["-m", "venv"])
-        .arg(&venv)
-        .output();
-    match made {
-        Ok(o) if o.status.success() => {}
-        Ok(o) => panic!(
-            "cannot create a Python venv at {} to read VTK files with meshio: {}\n\
-             install python3 with its venv module (Debian: apt-get install python3-venv)",
-            venv.display(),
-            String::from_utf8_lossy(&o.stderr)
-        ),
-        Err(e) => panic!(
-            "cannot run python3 ({e}) to read VTK files with meshio: install python3 (3.9 or later)"
-        ),
-    }
-    let pip = Command::new(&python)
-        .args(["-m", "pip", "install", "--quiet", "meshio"])
-        .output()
-        .expect("the venv's python runs");
-    assert!(
-        pip.status.success() && has_meshio(&python),
-        "cannot install meshio from PyPI into {}: {}\n\
-         check the network, or install it yourself: {} -m pip install meshio",
-        venv.display(),
-        String::from_utf8_lossy(&pip.stderr),
-        python.display()
-    );
-    python
+    common::python_with_meshio().unwrap_or_else(|e| panic!("{e}"))
 }
 
 const READ: &str = r#"

@@ -13,7 +13,7 @@ use crate::contact::settle::{newton_limits, Problem, PATH_POINTS};
 use crate::contact::{ActiveContact, ContactError, ContactSet, ContactSolver, Obstacle};
 use crate::linalg::CholeskyError;
 use crate::linkage::body_state::{loads_at, norm, prescribed_at};
-use crate::linkage::{Body, IncrementSize};
+use crate::linkage::{lagrange_weights, Body, IncrementSize};
 use crate::Real;
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -180,15 +180,8 @@ impl ContactSolver {
         let mut chosen = None;
         for points in 2..=n {
             let tail = &self.path[n - points..];
-            // Lagrange weights of the points at t1.
-            let weights: Vec<Real> = (0..points)
-                .map(|j| {
-                    (0..points)
-                        .filter(|&m| m != j)
-                        .map(|m| (t1 - tail[m].0) / (tail[j].0 - tail[m].0))
-                        .product()
-                })
-                .collect();
+            let times: Vec<Real> = tail.iter().map(|p| p.0).collect();
+            let weights = lagrange_weights(&times, t1);
             for (b, part) in self.parts.iter_mut().enumerate() {
                 for &dof in &part.dofs.free {
                     part.u[dof] = tail

@@ -17,8 +17,8 @@ pub use self::mechanism::Mechanism;
 pub use self::member_check::check_members;
 pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
-pub(crate) use self::newton::IncrementSize;
 pub use self::newton::NewtonEquilibrium;
+pub(crate) use self::newton::{lagrange_weights, IncrementSize};
 pub use self::solver_choice::{
     IterativeSettings, SolverChoice, SolverSettings, SolverUsed, AUTO_CONTACT_ITERATIVE_DOFS_3D,
     AUTO_ITERATIVE_DOFS_2D, AUTO_ITERATIVE_DOFS_3D,

@@ -1,10 +1,12 @@
 //! Scenes the test binaries share.
 
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 /// The bundled von Mises truss under load control, named `name`, with `force` N down at its
 /// apex, in `dir/file`: 7622 N is its limit load, so 5000 N solves its 4 steps and 9000 N
 /// fails at step 4 (at most 3 halvings of an increment).
+#[allow(dead_code)] // not every test binary runs the truss
 pub fn truss_scene(dir: &Path, file: &str, name: &str, force: f64) -> PathBuf {
     let here = std::env::current_dir().unwrap().join("scenes");
     let scene = dir.join(file);
@@ -38,4 +40,50 @@ force = [0.0, {}]
     )
     .unwrap();
     scene
+}
+
+/// A Python with meshio (and so numpy): `target/meshio-venv`, created and filled when missing
+/// (`.ci/run` installs it first); the error says why it cannot be made here.
+#[allow(dead_code)] // not every test binary reads with Python
+pub fn python_with_meshio() -> Result<PathBuf, String> {
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/meshio-venv");
+    let python = venv.join("bin/python");
+    let has_meshio = |py: &Path| {
+        Command::new(py)
+            .args(["-c", "import meshio, numpy"])
+            .output()
+            .map(|o| o.status.success())
+            .unwrap_or(false)
+    };
+    if has_meshio(&python) {
+        return Ok(python);
+    }
+    let made = Command::new("python3")
+        .args(["-m", "venv"])
+        .arg(&venv)
+        .output()
+        .map_err(|e| format!("cannot run python3 ({e}): install python3 (3.9 or later)"))?;
+    if !made.status.success() {
+        return Err(format!(
+            "cannot create a Python venv at {}: {}\n\
+             install python3 with its venv module (Debian: apt-get install python3-venv)",
+            venv.display(),
+            String::from_utf8_lossy(&made.stderr)
+        ));
+    }
+    let pip = Command::new(&python)
+        .args(["-m", "pip", "install", "--quiet", "meshio"])
+        .output()
+        .map_err(|e| format!("cannot run the venv's python: {e}"))?;
+    if pip.status.success() && has_meshio(&python) {
+        Ok(python)
+    } else {
+        Err(format!(
+            "cannot install meshio from PyPI into {}: {}\n\
+             check the network, or install it yourself: {} -m pip install meshio",
+            venv.display(),
+            String::from_utf8_lossy(&pip.stderr),
+            python.display()
+        ))
+    }
 }

@@ -4,7 +4,7 @@
 //! from the path extrapolated through the last converged states when that is closer to
 //! equilibrium.
 
-use super::{IncrementFailure, IncrementSize, NewtonEquilibrium, PATH_POINTS};
+use super::{lagrange_weights, IncrementFailure, IncrementSize, NewtonEquilibrium, PATH_POINTS};
 use crate::linkage::body_state::{norm, prescribed_at, tangent_times};
 use crate::linkage::step_state::force_scale;
 use crate::linkage::{Body, Convergence, SolveError};
@@ -190,15 +190,8 @@ impl NewtonEquilibrium {
         let mut chosen = None;
         for points in 2..=n {
             let tail = &self.path[n - points..];
-            // Lagrange weights of the points at t1.
-            let weights: Vec<Real> = (0..points)
-                .map(|j| {
-                    (0..points)
-                        .filter(|&m| m != j)
-                        .map(|m| (t1 - tail[m].0) / (tail[j].0 - tail[m].0))
-                        .product()
-                })
-                .collect();
+            let times: Vec<Real> = tail.iter().map(|p| p.0).collect();
+            let weights = lagrange_weights(&times, t1);
             for &dof in &self.dofs.free {
                 self.u[dof] = tail.iter().zip(&weights).map(|(p, w)| w * p.1[dof]).sum();
             }

@@ -99,6 +99,20 @@ pub struct NewtonEquilibrium {
 /// Converged states kept for the extrapolation (three: up to a quadratic through them).
 const PATH_POINTS: usize = 3;
 
+/// The Lagrange weights at `t` of the points at `times` (distinct): the polynomial through
+/// values at `times` is, at `t`, the sum of each value times its weight (a secant through two
+/// converged states, a quadratic through three).
+pub(crate) fn lagrange_weights(times: &[Real], t: Real) -> Vec<Real> {
+    (0..times.len())
+        .map(|j| {
+            (0..times.len())
+                .filter(|&m| m != j)
+                .map(|m| (t - times[m]) / (times[j] - times[m]))
+                .product()
+        })
+        .collect()
+}
+
 impl NewtonEquilibrium {
     /// Validate `body`, build its pattern, analyze it once and check that the undeformed
     /// tangent is not singular (a mechanism is reported with its nodes).
@@ -437,5 +451,20 @@ fn not_converged(
         cuts: size.cuts,
         reason: failure.reason,
         history: failure.history,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::lagrange_weights;
+
+    #[test]
+    fn lagrange_weights_extrapolate_a_secant_and_a_parabola_exactly() {
+        assert_eq!(lagrange_weights(&[0.0, 1.0], 2.0), [-1.0, 2.0]);
+        let times = [1.0, 1.5, 2.0];
+        let w = lagrange_weights(&times, 2.5);
+        let at: f64 = times.iter().zip(&w).map(|(t, w)| w * t * t).sum();
+        assert!((at - 6.25).abs() < 1e-14, "{at}");
+        assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-15);
     }
 }
