@@ -1,5 +1,6 @@
 //! The `linkage` command line: thin; it parses arguments and calls the library.
 
+mod batch_cli;
 mod bench_cli;
 
 use anyhow::{bail, Context, Result};
@@ -7,7 +8,8 @@ use bench_cli::{bench, bench_contact, bench_large, bench_read, bench_render};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
-use linkage::scene::{load_scene, run_until, Summary, World};
+use linkage::scene::batch::{self, JobSettings, Ran, SlurmOptions};
+use linkage::scene::load_scene;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -44,6 +46,42 @@ enum Command {
         /// Also write vtk/NNNN.vtu per stored step and vtk/<scene>.pvd for ParaView.
         #[arg(long)]
         vtk: bool,
+        /// Run only the I-th of N slices of the jobs (scenes and sweep variants), writing
+        /// DIR/batch.part-I-of-N.csv; "slurm": I and N from the job array's variables.
+        #[arg(long, value_name = "I/N|slurm")]
+        shard: Option<String>,
+        /// Run jobs whose complete results are already in DIR (they are skipped otherwise).
+        #[arg(long)]
+        rerun: bool,
+    },
+    // Batches: `collect` and `slurm` (sweeps and shards are options of `run`).
+    /// Merge the shards' DIR/batch.part-I-of-N.csv into DIR/batch.csv; say which jobs are
+    /// missing or failed.
+    Collect {
+        /// The --out folder of the sharded runs.
+        dir: PathBuf,
+    },
+    /// Write DIR/linkage.sbatch, a Slurm job array whose tasks run the shards of SCENES, and
+    /// DIR/linkage-collect.sbatch; print the sbatch commands.
+    Slurm {
+        /// Scene files (TOML).
+        #[arg(required = true)]
+        scenes: Vec<PathBuf>,
+        /// Output folder of the batch (and of the scripts).
+        #[arg(long)]
+        out: PathBuf,
+        /// Array tasks (at most one per job; default: one per 8 jobs).
+        #[arg(long)]
+        tasks: Option<usize>,
+        /// Wall-time limit per task, e.g. 01:00:00.
+        #[arg(long)]
+        time: Option<String>,
+        /// Cores per task.
+        #[arg(long, default_value_t = 1)]
+        cpus_per_task: usize,
+        /// Slurm partition.
+        #[arg(long)]
+        partition: Option<String>,
     },
     /// Draw a stored run again (png/NNNN.png, replacing the frames in png/; anim.gif; --vtk for
     /// ParaView files) without solving.
@@ -206,7 +244,33 @@ fn main() -> ExitCode {
             jobs,
             png,
             vtk,
-        } => run_scenes(&scenes, &out, jobs, png, vtk),
+            shard,
+            rerun,
+        } => run_scenes(
+            &scenes,
+            &out,
+            jobs,
+            shard.as_deref(),
+            JobSettings { png, vtk, rerun },
+        ),
+        Command::Collect { dir } => batch_cli::collect(&dir),
+        Command::Slurm {
+            scenes,
+            out,
+            tasks,
+            time,
+            cpus_per_task,
+            partition,
+        } => batch_cli::slurm(
+            &scenes,
+            &out,
+            SlurmOptions {
+                tasks,
+                time,
+                cpus_per_task,
+                partition,
+            },
+        ),
         Command::Check { scenes } => check_scenes(&scenes),
         Command::Export { scene, out } => export(&scene, &out),
         Command::Render(args) => render(&args),
@@ -295,34 +359,49 @@ fn run_scenes(
     scenes: &[PathBuf],
     out: &Path,
     jobs: Option<usize>,
-    png: bool,
-    vtk: bool,
+    shard: Option<&str>,
+    settings: JobSettings,
 ) -> Result<()> {
     catch_signals();
+    let shard = shard.map(batch::Shard::parse).transpose()?;
+    // Every sweep is expanded (and a wrong key named) before anything runs.
+    let planned = batch::plan_jobs(scenes)?;
     create_out_folder(out)?;
+    batch::write_variant_lists(&planned, out)?;
+    if shard.is_some() {
+        batch::write_job_list(&planned, out)?;
+    }
+    let mine: Vec<&batch::Job> = planned
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| shard.is_none_or(|s| s.takes(*j)))
+        .map(|(_, job)| job)
+        .collect();
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} steps {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar())
             .progress_chars("=> "),
     );
-    let one_scene = |path: &PathBuf| -> Result<(World, Summary, f64)> {
-        let t = Instant::now();
-        let mut world = load_scene(path)?;
-        if png {
-            world.pictures.ask_png();
-        }
-        world.pictures.vtk |= vtk;
+    let on_start = |world: &linkage::scene::World| {
         // Said before the run starts, so a user can stop it before it fills the disk.
-        if let Some(w) = linkage::scene::output_warning(&world) {
+        if let Some(w) = linkage::scene::output_warning(world) {
             bar.suspend(|| eprintln!("warn  {}: {w}", world.name));
         }
         bar.inc_length(world.steps as u64 + 1);
-        let summary = run_until(&world, out, &|| bar.inc(1), Some(&PictureWriter), &STOP)?;
-        Ok((world, summary, t.elapsed().as_secs_f64()))
     };
-    let work =
-        || -> Vec<Result<(World, Summary, f64)>> { scenes.par_iter().map(one_scene).collect() };
+    let one_job = |job: &&batch::Job| {
+        batch::run_job(
+            job,
+            out,
+            settings,
+            Some(&PictureWriter),
+            &on_start,
+            &|| bar.inc(1),
+            &STOP,
+        )
+    };
+    let work = || -> Vec<(Ran, batch::Row)> { mine.par_iter().map(one_job).collect() };
     let results = match jobs {
         Some(0) => bail!("--jobs 0: give 1 or more"),
         Some(n) => rayon::ThreadPoolBuilder::new()
@@ -335,24 +414,38 @@ fn run_scenes(
     bar.finish_and_clear();
     let mut failed = 0;
     let mut written: Vec<(String, PathBuf)> = Vec::new();
-    for (path, result) in scenes.iter().zip(results) {
-        match result {
-            Ok((world, summary, seconds)) => {
-                if let Some((_, first)) = written.iter().find(|(n, _)| *n == world.name) {
+    let mut rows = Vec::with_capacity(results.len());
+    for (job, (ran, row)) in mine.iter().zip(results) {
+        rows.push(row);
+        let path = &job.scene;
+        let shown = match job.variant {
+            Some(k) => format!("{} [{k}]", path.display()),
+            None => path.display().to_string(),
+        };
+        match ran {
+            Ran::Skipped => println!(
+                "skip  {shown} -> {}: complete results there (--rerun runs it again)",
+                job.folder(out).display()
+            ),
+            Ran::Solved {
+                world,
+                summary,
+                seconds,
+            } => {
+                if let Some((_, first)) = written.iter().find(|(n, _)| *n == job.id()) {
                     println!(
                         "warn  {} and {} share the name '{}': {} holds whichever finished last",
                         first.display(),
                         path.display(),
                         world.name,
-                        out.join(&world.name).display()
+                        job.folder(out).display()
                     );
                 }
-                written.push((world.name.clone(), path.clone()));
+                written.push((job.id(), path.clone()));
                 let last = summary.steps.last();
                 println!(
-                    "ok    {} -> {}: {}; {:.3} s; max |u| {:.4e} m; {} overloaded; residual {:.1e}",
-                    path.display(),
-                    out.join(&world.name).display(),
+                    "ok    {shown} -> {}: {}; {:.3} s; max |u| {:.4e} m; {} overloaded; residual {:.1e}",
+                    job.folder(out).display(),
                     world.describe_solved(summary.bodies.iter().map(|b| b.free_dofs).sum()),
                     seconds,
                     last.map_or(0.0, |s| s.max_displacement),
@@ -372,23 +465,32 @@ fn run_scenes(
                     }
                 }
             }
-            Err(e) => {
+            Ran::Failed(msg) => {
                 failed += 1;
                 // Errors name their file; prefix the scene when they name another one.
-                let msg = e.to_string();
                 if msg.starts_with(&path.display().to_string()) {
                     println!("FAIL  {msg}");
                 } else {
-                    println!("FAIL  {}: {msg}", path.display());
+                    println!("FAIL  {shown}: {msg}");
                 }
             }
         }
     }
+    let table = out.join(match shard {
+        Some(s) => s.part_name(),
+        None => batch::TABLE.to_string(),
+    });
+    batch::write_table(&table, &rows)?;
     if failed > 0 {
+        let noun = if mine.iter().any(|j| j.variant.is_some()) {
+            "job"
+        } else {
+            "scene"
+        };
         bail!(
-            "{failed} of {} scene{} failed",
-            scenes.len(),
-            if scenes.len() == 1 { "" } else { "s" }
+            "{failed} of {} {noun}{} failed",
+            mine.len(),
+            if mine.len() == 1 { "" } else { "s" }
         );
     }
     Ok(())

@@ -44,9 +44,22 @@ pub fn run_until(
     draw: Option<&dyn DrawResults>,
     stop: &AtomicBool,
 ) -> Result<Summary, RunError> {
-    let final_dir = out.join(&world.name);
-    remove_stale(out, &world.name);
-    let staging = staging_dir(out, &world.name);
+    run_into(world, out, &world.name, on_step, draw, stop)
+}
+
+/// [`run_until`], writing `out/<folder>/` instead of `out/<name>/` (a sweep's variant `k` of
+/// scene `s` is `DIR/s/k/`, its summary still naming the scene `s`).
+pub fn run_into(
+    world: &World,
+    out: &Path,
+    folder: &str,
+    on_step: &(dyn Fn() + Sync),
+    draw: Option<&dyn DrawResults>,
+    stop: &AtomicBool,
+) -> Result<Summary, RunError> {
+    let final_dir = out.join(folder);
+    remove_stale(out, folder);
+    let staging = staging_dir(out, folder);
     let result = run_in(world, &staging, &final_dir, on_step, draw, stop);
     if staging.exists() {
         let _ = std::fs::remove_dir_all(&staging);

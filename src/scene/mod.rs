@@ -5,7 +5,7 @@ pub use self::check::{
     check_world, obstacle_offset_bytes, output_warning, step_file_bytes, stored_steps, CheckReport,
     BYTES_PER_VALUE, NPZ_BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
 };
-pub use self::driver::{run, run_until, run_with};
+pub use self::driver::{run, run_into, run_until, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::result_format::{ResultFormat, NPZ_ABOVE_MEMBERS};
@@ -18,12 +18,14 @@ pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS}
 pub use self::selector::select_nodes;
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
+pub use self::sweep::{expand_sweep, SweepMode, Variant};
 pub use self::vtk::{write_vtk, VtkError};
 pub use self::vtu_arrays::VtkEncoding;
 pub use self::world::{OutputSettings, World};
 pub use self::writers::DrawResults;
 
 pub mod atomic_file;
+pub mod batch;
 mod bounds;
 mod build;
 mod check;
@@ -46,6 +48,7 @@ mod selector;
 mod simulation;
 pub mod spec;
 mod stored_run;
+pub mod sweep;
 mod vtk;
 mod vtu_arrays;
 mod world;

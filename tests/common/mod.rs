@@ -87,3 +87,72 @@ pub fn python_with_meshio() -> Result<PathBuf, String> {
         ))
     }
 }
+
+/// The files under `root`, relative and sorted.
+#[allow(dead_code)] // used by the batch tests
+pub fn files_under(root: &Path) -> Vec<PathBuf> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap().flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                walk(root, &path, out);
+            } else {
+                out.push(path.strip_prefix(root).unwrap().to_path_buf());
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(root, root, &mut out);
+    out.sort();
+    out
+}
+
+/// Assert that two results folders hold the same files, byte for byte, except the timing
+/// fields of summary.json (`seconds` per step and `phases`), which differ between runs (as
+/// `.ci/same_outputs.py` compares them).
+#[allow(dead_code)] // used by the batch tests
+pub fn assert_same_results(a: &Path, b: &Path) {
+    fn strip(v: serde_json::Value) -> serde_json::Value {
+        match v {
+            serde_json::Value::Object(m) => m
+                .into_iter()
+                .filter(|(k, _)| k != "seconds" && k != "phases")
+                .map(|(k, v)| (k, strip(v)))
+                .collect(),
+            serde_json::Value::Array(a) => a.into_iter().map(strip).collect(),
+            v => v,
+        }
+    }
+    let files = files_under(a);
+    assert_eq!(files, files_under(b), "{} and {}", a.display(), b.display());
+    assert!(!files.is_empty(), "{} is empty", a.display());
+    for f in files {
+        let (x, y) = (
+            std::fs::read(a.join(&f)).unwrap(),
+            std::fs::read(b.join(&f)).unwrap(),
+        );
+        if f.file_name().is_some_and(|n| n == "summary.json") {
+            let parse = |bytes: &[u8]| strip(serde_json::from_slice(bytes).unwrap());
+            assert_eq!(parse(&x), parse(&y), "{}", f.display());
+        } else {
+            assert!(
+                x == y,
+                "{} differs between {} and {}",
+                f.display(),
+                a.display(),
+                b.display()
+            );
+        }
+    }
+}
+
+/// The rows of a `batch.csv` without its `seconds` column (wall times differ between runs).
+#[allow(dead_code)] // used by the batch tests
+pub fn table_without_seconds(path: &Path) -> Vec<linkage::scene::batch::Row> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut rows = linkage::scene::batch::parse_table(&text).unwrap();
+    for r in &mut rows {
+        r.seconds.clear();
+    }
+    rows
+}

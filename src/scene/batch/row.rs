@@ -1,0 +1,122 @@
+//! A job's row of the batch table, read from its published results folder (so a job skipped
+//! because its results are there gets the same row as the run that wrote them).
+
+use crate::scene::batch::jobs::Job;
+use crate::scene::batch::table::{contact_column, Row};
+use crate::scene::{StepResult, StoredRun, Summary, World};
+use crate::Real;
+use std::path::Path;
+
+/// The summary of `folder` when it holds complete results of scene `name`: `summary.json`
+/// (written last, and published with the folder in one rename) is there, reads, names the scene
+/// and says no step failed.
+pub fn complete_summary(folder: &Path, name: &str) -> Option<Summary> {
+    let bytes = std::fs::read(folder.join("summary.json")).ok()?;
+    let summary: Summary = serde_json::from_slice(&bytes).ok()?;
+    (summary.scene == name && summary.failure.is_none()).then_some(summary)
+}
+
+/// The row of `job`: `status` (`ok` or `failed: …`), and, when `results` (a folder the run
+/// published, complete or stopped early) reads, its numbers; `world` gives the strengths.
+pub fn job_row(job: &Job, status: String, results: Option<&Path>, world: Option<&World>) -> Row {
+    let mut row = Row {
+        job: job.id(),
+        scene: job.name.clone(),
+        variant: job.variant.map(|k| k.to_string()).unwrap_or_default(),
+        values: job.value_cells(),
+        status,
+        ..Row::default()
+    };
+    let Some(dir) = results else {
+        return row;
+    };
+    let Some(summary) = std::fs::read(dir.join("summary.json"))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<Summary>(&b).ok())
+    else {
+        return row;
+    };
+    row.nodes = summary
+        .bodies
+        .iter()
+        .map(|b| b.nodes)
+        .sum::<usize>()
+        .to_string();
+    row.members = summary
+        .bodies
+        .iter()
+        .map(|b| b.members)
+        .sum::<usize>()
+        .to_string();
+    let seconds: Real = summary.steps.iter().map(|s| s.seconds).sum();
+    row.seconds = format!("{seconds:.6}");
+    if let Some(last) = summary.steps.last() {
+        row.steps = last.step.to_string();
+        row.max_displacement = format!("{:e}", last.max_displacement);
+        row.overloaded = last.overloaded.to_string();
+        for pair in &last.contact_forces {
+            for (axis, f) in pair.force.iter().enumerate() {
+                row.contact.push((
+                    contact_column(&pair.body, &pair.with, axis),
+                    format!("{f:e}"),
+                ));
+            }
+        }
+    }
+    let residual = summary
+        .steps
+        .iter()
+        .map(|s| s.residual)
+        .fold(0.0, Real::max);
+    row.residual = format!("{residual:e}");
+    let warnings: Vec<&str> = summary
+        .steps
+        .iter()
+        .flat_map(|s| s.warnings.iter().map(String::as_str))
+        .collect();
+    row.warnings = warnings.join("; ");
+    if let Some(step) = StoredRun::open(dir)
+        .ok()
+        .and_then(|run| run.steps.last().and_then(|&k| run.read_step(k).ok()))
+    {
+        let (peak, ratio) = peak_stress(&step, world);
+        row.peak_stress = peak.map(|p| format!("{p:e}")).unwrap_or_default();
+        row.stress_ratio = ratio.map(|r| format!("{r:e}")).unwrap_or_default();
+    }
+    row
+}
+
+/// The member stress of largest magnitude in `step` (Pa, signed), and the largest |σ| over the
+/// strength of its member's material in that sense (tensile for σ > 0, compressive for σ < 0),
+/// over the members of `world` that have one.
+fn peak_stress(step: &StepResult, world: Option<&World>) -> (Option<Real>, Option<Real>) {
+    let mut peak: Option<Real> = None;
+    let mut ratio: Option<Real> = None;
+    for body in &step.bodies {
+        let model = world.and_then(|w| w.bodies.iter().find(|b| b.name == body.name));
+        for (m, &s) in body.stresses.iter().enumerate() {
+            if peak.is_none_or(|p| s.abs() > p.abs()) {
+                peak = Some(s);
+            }
+            let material = model.and_then(|b| {
+                b.members
+                    .get(m)
+                    .and_then(|member| b.materials.get(member.material))
+            });
+            let strength = material.and_then(|mat| {
+                if s >= 0.0 {
+                    mat.tensile_strength
+                } else {
+                    mat.compressive_strength
+                }
+            });
+            if let Some(limit) = strength.filter(|l| *l > 0.0) {
+                let r = s.abs() / limit;
+                if ratio.is_none_or(|q| r > q) {
+                    ratio = Some(r);
+                }
+            }
+        }
+    }
+    (peak, ratio)
+}
