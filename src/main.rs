@@ -498,12 +498,28 @@ fn run_scenes(
 
 fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
     let mut failed = 0;
-    for path in scenes {
-        let checked = load_scene(path)
-            .map_err(anyhow::Error::from)
-            .and_then(|world| Ok(linkage::scene::check_world(&world)?));
+    // Every variant of a sweep is checked as it would run.
+    let jobs = batch::plan_jobs(scenes)?;
+    for job in &jobs {
+        let path = &job.scene;
+        let checked = match job.variant {
+            None => load_scene(path).map_err(anyhow::Error::from),
+            Some(_) => job
+                .text
+                .as_deref()
+                .map_err(|e| anyhow::anyhow!("{e}"))
+                .and_then(|text| {
+                    linkage::scene::build_world(text, path)
+                        .map_err(|e| anyhow::anyhow!(job.describe_error(&e.to_string())))
+                }),
+        }
+        .and_then(|world| Ok(linkage::scene::check_world(&world)?));
+        let shown = match job.variant {
+            Some(k) => PathBuf::from(format!("{} [{k}]", path.display())),
+            None => path.clone(),
+        };
         match checked {
-            Ok(report) => print_check(path, &report),
+            Ok(report) => print_check(&shown, &report),
             Err(e) => {
                 failed += 1;
                 // As `linkage run` prints it: errors name their file; prefix the scene when
@@ -512,7 +528,7 @@ fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
                 if msg.starts_with(&path.display().to_string()) {
                     println!("FAIL  {msg}");
                 } else {
-                    println!("FAIL  {}: {msg}", path.display());
+                    println!("FAIL  {}: {msg}", shown.display());
                 }
             }
         }
@@ -520,8 +536,8 @@ fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
     if failed > 0 {
         bail!(
             "{failed} of {} scene{} failed the check",
-            scenes.len(),
-            if scenes.len() == 1 { "" } else { "s" }
+            jobs.len(),
+            if jobs.len() == 1 { "" } else { "s" }
         );
     }
     Ok(())

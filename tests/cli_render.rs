@@ -92,7 +92,7 @@ fn run_png_vtk_then_render_again_with_other_options() {
     assert_eq!(listing(&dir.join("png")), ["0001.png", "notes.txt"]);
     assert_eq!(
         listing(out.path()),
-        ["paper_square"],
+        ["batch.csv", "paper_square"],
         "no staging folder left"
     );
     assert_eq!(
@@ -153,8 +153,11 @@ fn bundled_scenes_produce_their_frames_and_gifs() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stdout));
     let mut folders = 0;
     for entry in std::fs::read_dir(out.path()).unwrap() {
-        folders += 1;
         let dir = entry.unwrap().path();
+        if !dir.is_dir() {
+            continue; // batch.csv
+        }
+        folders += 1;
         let steps = std::fs::read_dir(dir.join("steps")).unwrap().count();
         let frames = std::fs::read_dir(dir.join("png")).unwrap().count();
         assert_eq!(frames, steps, "{}", dir.display());

@@ -116,7 +116,10 @@ fn a_stale_staging_folder_of_a_dead_process_is_removed_by_the_next_run() {
     assert!(!stale.exists());
     // Another scene's leftovers are its own next run's to remove.
     assert!(other.exists());
-    assert_eq!(listing(&out), vec![".other.partial-4194305-0", "truss"]);
+    assert_eq!(
+        listing(&out),
+        vec![".other.partial-4194305-0", "batch.csv", "truss"]
+    );
 }
 
 /// A scene that takes many seconds: a 12×12×12-cell lattice written at each of 3000 steps.
@@ -194,7 +197,12 @@ fn stops_cleanly_on(signal: &str) {
         stdout.contains("interrupted before step") && stdout.contains("no results written"),
         "{stdout}"
     );
-    assert_eq!(listing(&out), vec!["slow"], "only the earlier results stay");
+    // The batch table says the run failed.
+    assert_eq!(
+        listing(&out),
+        vec!["batch.csv", "slow"],
+        "only the earlier results stay"
+    );
     assert_eq!(
         std::fs::read_to_string(earlier.join("summary.json")).unwrap(),
         "{\"steps\": []}"
@@ -245,6 +253,6 @@ fn fifty_pairs_of_concurrent_runs_of_one_name_all_succeed() {
         .output()
         .unwrap();
     assert!(output.status.success(), "{output:?}");
-    assert_eq!(listing(&out), vec!["paper_square"]);
+    assert_eq!(listing(&out), vec!["batch.csv", "paper_square"]);
     assert!(summary(&out.join("paper_square")).get("failure").is_none());
 }

@@ -413,4 +413,52 @@ fn a_resumed_batch_skips_finished_jobs_and_reruns_the_rest() {
         "{stdout}"
     );
     assert_eq!(table_without_seconds(&out.join("batch.csv")), first);
+    // An edited scene is run again: the summary's scene_digest no longer matches.
+    let edited = std::fs::read_to_string(&scene)
+        .unwrap()
+        .replace("area = 1e-4", "area = 2e-4");
+    std::fs::write(&scene, edited).unwrap();
+    let stdout = run(&[]);
+    assert_eq!(
+        stdout.lines().filter(|l| l.starts_with("ok    ")).count(),
+        6,
+        "{stdout}"
+    );
+    let u = |rows: &[linkage::scene::batch::Row]| rows[0].max_displacement.parse::<f64>().unwrap();
+    let halved = u(&table_without_seconds(&out.join("batch.csv"))) / u(&first);
+    assert!((halved - 0.5).abs() < 1e-12, "{halved}");
+}
+
+#[test]
+fn a_variant_that_cannot_be_built_fails_alone_and_check_checks_every_variant() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = "\n[sweep]\n\"materials.steel.youngs_modulus\" = [200e9, -1.0]\n";
+    let scene = write(dir.path(), "sq.toml", &square("200e9", "200.0", sweep));
+    let o = Command::new(env!("CARGO_BIN_EXE_linkage"))
+        .arg("check")
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let said = text(&o);
+    assert!(
+        said.contains(&format!("ok    {} [1]", scene.display())),
+        "{said}"
+    );
+    let fail = format!(
+        "FAIL  {}: [sweep] variant 2 (materials.steel.youngs_modulus = -1.0): ",
+        scene.display()
+    );
+    assert!(said.contains(&fail), "{said}");
+    let out = dir.path().join("out");
+    let o = linkage(&["run", scene.to_str().unwrap()], &out);
+    assert!(!o.status.success());
+    assert!(text(&o).contains(&fail), "{}", text(&o));
+    assert!(text(&o).contains("1 of 2 jobs failed"), "{}", text(&o));
+    assert!(out.join("sq/1/summary.json").is_file());
+    assert!(!out.join("sq/2").exists());
+    let rows = table_without_seconds(&out.join("batch.csv"));
+    assert_eq!(rows[0].status, "ok");
+    assert!(rows[1].status.starts_with("failed: "), "{:?}", rows[1]);
+    assert!(rows[1].status.contains("youngs_modulus"), "{:?}", rows[1]);
 }

@@ -254,6 +254,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         output,
         pictures,
         source: path.to_path_buf(),
+        scene_digest: crate::scene::scene_digest(text),
     })
 }
 

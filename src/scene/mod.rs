@@ -15,6 +15,7 @@ pub use self::results::{
 };
 pub use self::run_error::RunError;
 pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS};
+pub use self::scene_digest::scene_digest;
 pub use self::selector::select_nodes;
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
@@ -44,6 +45,7 @@ mod result_format;
 mod results;
 mod run_error;
 mod run_results;
+mod scene_digest;
 mod selector;
 mod simulation;
 pub mod spec;

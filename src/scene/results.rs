@@ -177,6 +177,10 @@ pub struct Summary {
     /// every step was solved.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub failure: Option<String>,
+    /// Fingerprint of the scene text that ran (FNV-1a 64, hex): a batch run again skips a job
+    /// only when it matches (absent in folders written before it).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub scene_digest: String,
 }
 
 /// Components of a vector for a body of dimension `d` (2 or 3).

@@ -27,6 +27,10 @@ pub struct SceneSpec {
     /// Rigid obstacles.
     #[serde(default)]
     pub obstacles: Vec<Spanned<ObstacleSpec>>,
+    /// `[sweep]`: expanded into variants before a batch reads them (`crate::scene::sweep`);
+    /// a scene read on its own builds with the values written outside it.
+    #[serde(default)]
+    pub sweep: Option<toml::Value>,
 }
 
 /// `[contact]`: penalty and tolerances (see `docs/SCENES.md`).

@@ -58,6 +58,9 @@ pub struct World {
     pub pictures: PictureSettings,
     /// The scene file it came from.
     pub source: PathBuf,
+    /// [`crate::scene::scene_digest`] of the text it was built from (a sweep's variant: its
+    /// generated text), written to `summary.json`.
+    pub scene_digest: String,
 }
 
 impl World {

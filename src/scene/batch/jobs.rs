@@ -59,6 +59,32 @@ impl Job {
         self.parent(out).join(self.folder_name())
     }
 
+    /// A scene error `message` of this job as the user should read it: a variant's names the
+    /// file, the variant and its values, without the line (which would point into the
+    /// variant's generated text); a scene's is `message` itself.
+    pub fn describe_error(&self, message: &str) -> String {
+        let Some(k) = self.variant else {
+            return message.to_string();
+        };
+        let path = self.scene.display().to_string();
+        let rest = message
+            .strip_prefix(&path)
+            .map(|r| {
+                r.trim_start_matches(|c: char| c == ':' || c.is_ascii_digit())
+                    .trim_start()
+            })
+            .unwrap_or(message);
+        let values: Vec<String> = self
+            .value_cells()
+            .iter()
+            .map(|(key, v)| format!("{key} = {v}"))
+            .collect();
+        format!(
+            "{path}: [sweep] variant {k} ({}): {rest}",
+            values.join(", ")
+        )
+    }
+
     /// The swept values as table cells.
     pub fn value_cells(&self) -> Vec<(String, String)> {
         self.values

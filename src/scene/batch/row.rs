@@ -7,13 +7,16 @@ use crate::scene::{StepResult, StoredRun, Summary, World};
 use crate::Real;
 use std::path::Path;
 
-/// The summary of `folder` when it holds complete results of scene `name`: `summary.json`
-/// (written last, and published with the folder in one rename) is there, reads, names the scene
-/// and says no step failed.
-pub fn complete_summary(folder: &Path, name: &str) -> Option<Summary> {
+/// The summary of `folder` when it holds complete results of `world`: `summary.json` (written
+/// last, and published with the folder in one rename) is there, reads, names the scene, came
+/// from the same scene text (its `scene_digest`) and says no step failed.
+pub fn complete_summary(folder: &Path, world: &World) -> Option<Summary> {
     let bytes = std::fs::read(folder.join("summary.json")).ok()?;
     let summary: Summary = serde_json::from_slice(&bytes).ok()?;
-    (summary.scene == name && summary.failure.is_none()).then_some(summary)
+    (summary.scene == world.name
+        && summary.scene_digest == world.scene_digest
+        && summary.failure.is_none())
+    .then_some(summary)
 }
 
 /// The row of `job`: `status` (`ok` or `failed: …`), and, when `results` (a folder the run

@@ -37,29 +37,6 @@ pub struct JobSettings {
     pub rerun: bool,
 }
 
-/// The scene error `message` of a variant, whose line numbers would point into the variant's
-/// generated text: said as the variant of the file, without the line.
-fn variant_message(job: &Job, message: &str) -> String {
-    let path = job.scene.display().to_string();
-    let rest = message
-        .strip_prefix(&path)
-        .map(|r| {
-            r.trim_start_matches(|c: char| c == ':' || c.is_ascii_digit())
-                .trim_start()
-        })
-        .unwrap_or(message);
-    let values: Vec<String> = job
-        .value_cells()
-        .iter()
-        .map(|(k, v)| format!("{k} = {v}"))
-        .collect();
-    format!(
-        "{path}: [sweep] variant {} ({}): {rest}",
-        job.variant.unwrap_or(0),
-        values.join(", ")
-    )
-}
-
 /// Run `job` into `out` (unless its complete results are there and `settings.rerun` is off) and
 /// make its row. `on_start` sees the world before it runs (for progress and warnings);
 /// `on_step`, `draw` and `stop` are [`run_into`]'s.
@@ -85,10 +62,7 @@ pub fn run_job(
     let started = std::time::Instant::now();
     let built = build_world(text, &job.scene).map_err(|e| {
         let message = e.to_string();
-        match job.variant {
-            Some(_) => variant_message(job, &message),
-            None => message,
-        }
+        job.describe_error(&message)
     });
     let mut world = match built {
         Ok(world) => world,
@@ -99,7 +73,7 @@ pub fn run_job(
             )
         }
     };
-    if !settings.rerun && complete_summary(&folder, &job.name).is_some() {
+    if !settings.rerun && complete_summary(&folder, &world).is_some() {
         let row = job_row(job, "ok".into(), Some(&folder), Some(&world));
         return (Ran::Skipped, row);
     }

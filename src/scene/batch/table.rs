@@ -22,8 +22,7 @@ pub struct Row {
     pub variant: String,
     /// Each swept key (dotted path) with this variant's value.
     pub values: Vec<(String, String)>,
-    /// `ok`, `failed: <why>` (or `collapsed` when members broke until the body could carry no
-    /// load).
+    /// `ok` or `failed: <why>`.
     pub status: String,
     /// Nodes, all bodies.
     pub nodes: String,
