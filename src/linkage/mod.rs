@@ -44,6 +44,7 @@ mod member_check;
 mod member_response;
 mod member_stiffness;
 mod newton;
+pub mod prepare;
 pub mod rigid_modes;
 mod solver_choice;
 mod step_state;
