@@ -63,6 +63,19 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Prepare a body from a closed OBJ/STL mesh (3D) or an outline file (2D): write
+    /// DIR/<stem>.nodes, .links (and .patches) and print the quality report.
+    Prepare {
+        /// A closed triangle mesh (.stl, .obj) or an outline (one "x y" per line, loops
+        /// separated by a blank line; the first the outside, the others holes), m.
+        input: PathBuf,
+        /// Target member length, m.
+        #[arg(long)]
+        spacing: f64,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Time assembly, ordering, factorization and solve on 3D box lattices.
     Bench {
         /// Lattice sizes in cells, e.g. 20x20x40 (default: a series up to over 1,000,000 members).
@@ -209,6 +222,11 @@ fn main() -> ExitCode {
         } => run_scenes(&scenes, &out, jobs, png, vtk),
         Command::Check { scenes } => check_scenes(&scenes),
         Command::Export { scene, out } => export(&scene, &out),
+        Command::Prepare {
+            input,
+            spacing,
+            out,
+        } => prepare(&input, spacing, &out),
         Command::Render(args) => render(&args),
         Command::Bench {
             read: true, cells, ..
@@ -444,6 +462,21 @@ fn print_check(path: &Path, report: &linkage::scene::CheckReport) {
     for w in &report.warnings {
         println!("warn  {}: {w}", path.display());
     }
+}
+
+fn prepare(input: &Path, spacing: f64, out: &Path) -> Result<()> {
+    let body = linkage::scene::prepare_file(input, spacing).map_err(anyhow::Error::msg)?;
+    create_out_folder(out)?;
+    let stem = input
+        .file_stem()
+        .map_or("body".into(), |s| s.to_string_lossy().into_owned());
+    let written = linkage::scene::write_prepared(out, &stem, &body)
+        .with_context(|| format!("cannot write the prepared body into {}", out.display()))?;
+    for path in written {
+        println!("wrote {}", path.display());
+    }
+    println!("{}", body.report);
+    Ok(())
 }
 
 fn export(scene: &Path, out: &Path) -> Result<()> {

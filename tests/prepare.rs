@@ -2,13 +2,18 @@
 //! nodes on the mesh, closed outward patches, dihedral angles, member lengths, a solve without
 //! a mechanism, determinism and bad input named.
 
-use linkage::linkage::prepare::{dihedral_angles, enclosed_volume, prepare_mesh, PreparedBody};
+use linkage::linkage::prepare::{
+    dihedral_angles, enclosed_volume, prepare_mesh, prepare_outline, PreparedBody,
+    MIN_TRIANGLE_ANGLE,
+};
 use linkage::linkage::{
     Body, Dimension, Equilibrium, Material, Member, NodalLoad, Schedule, Support,
 };
 use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::f64::consts::PI;
+use std::path::Path;
+use std::process::Command;
 
 /// A sphere of `radius` (m) as an icosahedron subdivided `levels` times, vertices on the
 /// sphere, faces outward.
@@ -280,4 +285,257 @@ fn a_degenerate_face_is_named() {
     t[3] = [a, b, v.len() - 1];
     let e = prepare_mesh(&v, &t, 0.01).unwrap_err().to_string();
     assert!(e.contains("face 4") && e.contains("no area"), "{e}");
+}
+
+/// The plate 0.4 m × 0.2 m with a 48-gon hole of radius 0.04 m at its centre.
+fn plate_with_hole() -> Vec<Vec<[f64; 2]>> {
+    let hole = (0..48)
+        .map(|i| {
+            let t = 2.0 * PI * i as f64 / 48.0;
+            [0.2 + 0.04 * t.cos(), 0.1 + 0.04 * t.sin()]
+        })
+        .collect();
+    vec![vec![[0.0, 0.0], [0.4, 0.0], [0.4, 0.2], [0.0, 0.2]], hole]
+}
+
+/// The distance from `p` to the nearest segment of the loops, m.
+fn distance_to_outline(loops: &[Vec<[f64; 2]>], p: Vector3<f64>) -> f64 {
+    let mut best = f64::INFINITY;
+    for l in loops {
+        for i in 0..l.len() {
+            let (a, b) = (l[i], l[(i + 1) % l.len()]);
+            let (a, b) = (Vector3::new(a[0], a[1], 0.0), Vector3::new(b[0], b[1], 0.0));
+            let s = ((p - a).dot(&(b - a)) / (b - a).norm_squared()).clamp(0.0, 1.0);
+            best = best.min((p - (a + (b - a) * s)).norm());
+        }
+    }
+    best
+}
+
+#[test]
+fn a_plate_with_a_hole_is_triangulated_within_half_a_percent_and_solves_in_tension() {
+    let loops = plate_with_hole();
+    let h = 0.01;
+    let p = prepare_outline(&loops, h).unwrap();
+    let g = &p.geometry;
+    println!("plate: {}", p.report);
+    // Area within 0.5% of the outline's (the 48-gon's area: 24 r² sin(2π/48)).
+    let hole_area = 24.0 * 0.04f64.powi(2) * (2.0 * PI / 48.0).sin();
+    let area = 0.08 - hole_area;
+    let triangles: f64 = p
+        .triangles
+        .iter()
+        .map(|&[a, b, c]| {
+            (g.nodes[b] - g.nodes[a])
+                .cross(&(g.nodes[c] - g.nodes[a]))
+                .z
+                / 2.0
+        })
+        .map(f64::abs)
+        .sum();
+    assert!((triangles / area - 1.0).abs() < 0.005, "{triangles} {area}");
+    assert!((p.report.reference - area).abs() < 1e-12);
+    // Minimum angle as documented.
+    assert!(
+        p.report.smallest_angle >= MIN_TRIANGLE_ANGLE,
+        "{}",
+        p.report.smallest_angle
+    );
+    // No member crossing the hole: its midpoint is not inside the hole.
+    for &[a, b] in &g.members {
+        let m = (g.nodes[a] + g.nodes[b]) / 2.0;
+        let r = ((m.x - 0.2).powi(2) + (m.y - 0.1).powi(2)).sqrt();
+        assert!(
+            r > 0.04 * (PI / 48.0).cos() - 1e-12,
+            "member {a}-{b} crosses the hole"
+        );
+    }
+    // Every boundary node on the outline: edges used by one triangle.
+    let mut uses: HashMap<(usize, usize), usize> = HashMap::new();
+    for &[a, b, c] in &p.triangles {
+        for (x, y) in [(a, b), (b, c), (c, a)] {
+            *uses.entry((x.min(y), x.max(y))).or_default() += 1;
+        }
+    }
+    let boundary: Vec<(usize, usize)> = uses
+        .iter()
+        .filter(|(_, &n)| n == 1)
+        .map(|(e, _)| *e)
+        .collect();
+    assert_eq!(boundary.len(), p.report.patches);
+    for &(a, b) in &boundary {
+        for n in [a, b] {
+            let d = distance_to_outline(&loops, g.nodes[n]);
+            assert!(
+                d < 1e-9 * 0.45,
+                "boundary node {n} is {d} m off the outline"
+            );
+        }
+    }
+    // Held on the left edge, pulled on the right: solved, no mechanism.
+    let mut body = Body::new("plate", Dimension::Two);
+    body.materials.push(Material::new("steel", 200e9, 1e-5));
+    body.nodes = g.nodes.clone();
+    body.members = g
+        .members
+        .iter()
+        .map(|&nodes| Member { nodes, material: 0 })
+        .collect();
+    for (n, q) in g.nodes.iter().enumerate() {
+        if q.x < 1e-12 {
+            body.supports
+                .push(Support::fixed(n, [true, q.y < 1e-12, false]));
+        } else if q.x > 0.4 - 1e-12 {
+            body.loads.push(NodalLoad {
+                node: n,
+                force: Vector3::new(100.0, 0.0, 0.0),
+                schedule: Schedule::Linear,
+            });
+        }
+    }
+    let eq = Equilibrium::new(&body).unwrap();
+    let state = eq.solve_step(&body, 1, 1).unwrap();
+    let right = g.nodes.iter().position(|q| q.x > 0.4 - 1e-12).unwrap();
+    assert!(state.displacements[right].x > 0.0);
+}
+
+#[test]
+fn a_bad_outline_is_named() {
+    let crossing = vec![vec![[0.0, 0.0], [2.0, 2.0], [2.0, 0.0], [0.0, 1.0]]];
+    let e = prepare_outline(&crossing, 0.1).unwrap_err().to_string();
+    assert!(
+        e.contains("segment 1 of loop 1") && e.contains("segment 3 of loop 1"),
+        "{e}"
+    );
+    let outside = vec![
+        vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+        vec![[2.0, 2.0], [3.0, 2.0], [3.0, 3.0]],
+    ];
+    let e = prepare_outline(&outside, 0.1).unwrap_err().to_string();
+    assert!(e.contains("loop 2 (a hole)"), "{e}");
+    let e = prepare_outline(&[vec![[0.0, 0.0], [1.0, 0.0]]], 0.1)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("loop 1 has 2 points"), "{e}");
+}
+
+fn linkage() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_linkage"))
+}
+
+/// A mesh as an OBJ file.
+fn write_obj(path: &Path, (v, t): &(Vec<Vector3<f64>>, Vec<[usize; 3]>)) {
+    let mut text = String::new();
+    for p in v {
+        text += &format!("v {:?} {:?} {:?}\n", p.x, p.y, p.z);
+    }
+    for f in t {
+        text += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn prepare_writes_the_paper_files_and_the_report_the_same_every_time() {
+    let dir = tempfile::tempdir().unwrap();
+    // Faces turned inward: the command turns them out, as for obstacles.
+    let (v, t) = sphere(0.05, 3);
+    let inward: Vec<[usize; 3]> = t.iter().map(|&[a, b, c]| [a, c, b]).collect();
+    let obj = dir.path().join("ball.obj");
+    write_obj(&obj, &(v, inward));
+    let mut files = Vec::new();
+    for run in ["a", "b"] {
+        let out = dir.path().join(run);
+        let o = linkage()
+            .args([
+                "prepare",
+                obj.to_str().unwrap(),
+                "--spacing",
+                "0.01",
+                "--out",
+            ])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            o.status.success(),
+            "{stdout} {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        for word in [
+            "nodes",
+            "members",
+            "patches",
+            "volume",
+            "member length",
+            "dihedral angle",
+        ] {
+            assert!(stdout.contains(word), "{word}: {stdout}");
+        }
+        files.push(
+            ["nodes", "links", "patches"]
+                .map(|e| std::fs::read(out.join(format!("ball.{e}"))).unwrap()),
+        );
+    }
+    assert_eq!(
+        files[0], files[1],
+        "the same input gives byte-identical files"
+    );
+    assert!(!files[0][2].is_empty());
+}
+
+#[test]
+fn an_open_mesh_is_named_by_its_edge() {
+    let dir = tempfile::tempdir().unwrap();
+    let (v, mut t) = sphere(0.05, 1);
+    t.remove(7);
+    let obj = dir.path().join("open.obj");
+    write_obj(&obj, &(v, t));
+    let o = linkage()
+        .args([
+            "prepare",
+            obj.to_str().unwrap(),
+            "--spacing",
+            "0.01",
+            "--out",
+        ])
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        stderr.contains("open.obj")
+            && stderr.contains("the edge from vertex")
+            && stderr.contains("open there"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("out").join("open.nodes").exists());
+}
+
+#[test]
+fn a_run_of_a_prepared_body_records_the_report_in_its_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    for (scene, body) in [("ring_press", "ring"), ("plate_with_hole", "plate")] {
+        let o = linkage()
+            .arg("run")
+            .arg(root.join(format!("{scene}.toml")))
+            .arg("--out")
+            .arg(dir.path())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let summary: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(dir.path().join(scene).join("summary.json")).unwrap(),
+        )
+        .unwrap();
+        let report = &summary["prepared"][body];
+        assert!(report["members"].as_u64().unwrap() > 1000, "{report}");
+        assert!(
+            report["relative_error"].as_f64().unwrap().abs() < 0.03,
+            "{report}"
+        );
+    }
 }

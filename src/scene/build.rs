@@ -2,6 +2,7 @@
 
 use crate::contact::Obstacle;
 use crate::linkage::generators;
+use crate::linkage::prepare::PrepareReport;
 use crate::linkage::{
     Behaviour, Body, Dimension, Geometry, Kinematics, Material, Member, NewtonSettings, NodalLoad,
     PathMethod, Schedule, SolverChoice, SolverSettings, Support,
@@ -9,6 +10,7 @@ use crate::linkage::{
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
+use crate::scene::prepared_body::prepared_geometry;
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
 use crate::scene::{OutputSettings, PictureSettings, ResultFormat, World};
@@ -198,8 +200,13 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     }
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut bodies: Vec<Body> = Vec::new();
+    let mut prepared = std::collections::BTreeMap::new();
     for b in &spec.bodies {
-        let body = build_body(b, &materials, (text, path), spec.steps, &at)?;
+        let mut report = None;
+        let body = build_body(b, &materials, (text, path), spec.steps, &at, &mut report)?;
+        if let Some(r) = report {
+            prepared.insert(body.name.clone(), r);
+        }
         if bodies.iter().any(|o| o.name == body.name) {
             return Err(at(
                 b.span(),
@@ -254,6 +261,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         output,
         pictures,
         source: path.to_path_buf(),
+        prepared,
     })
 }
 
@@ -335,13 +343,15 @@ fn newton_settings(spec: &BodySpec) -> Result<NewtonSettings, String> {
 }
 
 /// Which generator keys a body gives, in the order `disk`, `rectangle`, `cylindrical_shell`,
-/// `box_lattice`.
-fn generated_by(spec: &BodySpec) -> [bool; 4] {
+/// `box_lattice`, `mesh`, `outline`.
+fn generated_by(spec: &BodySpec) -> [bool; 6] {
     [
         spec.disk.is_some(),
         spec.rectangle.is_some(),
         spec.cylindrical_shell.is_some(),
         spec.box_lattice.is_some(),
+        spec.mesh.is_some(),
+        spec.outline.is_some(),
     ]
 }
 
@@ -361,6 +371,7 @@ fn build_body(
     (text, scene): (&str, &Path),
     steps: usize,
     at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
+    report: &mut Option<PrepareReport>,
 ) -> Result<Body, SceneError> {
     let folder = scene.parent().unwrap_or(Path::new("."));
     let spec = spanned.get_ref();
@@ -465,7 +476,7 @@ fn build_body(
     let from_files = spec.nodes.is_some() || spec.links.is_some();
     if generated + usize::from(from_files) != 1 {
         return Err(here(
-            "give the geometry either as files (`nodes` and `links`, optionally `patches`) or as exactly one generator (`disk`, `rectangle`, `cylindrical_shell`, `box_lattice`)".to_string(),
+            "give the geometry either as files (`nodes` and `links`, optionally `patches`) or as exactly one generator (`disk`, `rectangle`, `cylindrical_shell`, `box_lattice`, `mesh`, `outline`)".to_string(),
         ));
     }
     let mut body = Body::new(&spec.name, Dimension::Two);
@@ -521,7 +532,11 @@ fn build_body(
                 "`patches` goes with `nodes` and `links` files, not with a generator".to_string(),
             ));
         }
-        let geometry: Geometry = if let Some(g) = &spec.disk {
+        let prepared = prepared_geometry(spec, folder).map_err(&here)?;
+        let geometry: Geometry = if let Some(p) = prepared {
+            *report = Some(p.report);
+            Ok(p.geometry)
+        } else if let Some(g) = &spec.disk {
             generators::disk(g.radius, g.rings, g.sectors)
         } else if let Some(g) = &spec.rectangle {
             generators::rectangle(g.width, g.height, g.cells[0], g.cells[1])
@@ -548,10 +563,17 @@ fn build_body(
             "patches are for 3D bodies; this body's nodes have 2 coordinates".to_string(),
         ));
     }
-    let generator = ["disk", "rectangle", "cylindrical_shell", "box_lattice"]
-        .into_iter()
-        .zip(generated_by(spec))
-        .find_map(|(key, g)| g.then_some(key));
+    let generator = [
+        "disk",
+        "rectangle",
+        "cylindrical_shell",
+        "box_lattice",
+        "mesh",
+        "outline",
+    ]
+    .into_iter()
+    .zip(generated_by(spec))
+    .find_map(|(key, g)| g.then_some(key));
     if let (Some(key), Some((n, v))) = (generator, beyond_bound(&body.nodes)) {
         return Err(here(format!(
             "`{key}` places node {} at the coordinate {v:e} m, too large to square (lengths and contact forces would overflow): give sizes in metres, within ±{MAX_LENGTH:e}",

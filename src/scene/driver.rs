@@ -81,6 +81,7 @@ fn run_in(
         bodies: simulation.sizes(),
         phases: PhaseSeconds::default(),
         failure: None,
+        prepared: world.prepared.clone(),
     };
     // The stored steps stay in memory only for the writers after the loop that need them.
     let keep = keeps_steps(world, draw);

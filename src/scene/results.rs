@@ -177,6 +177,10 @@ pub struct Summary {
     /// every step was solved.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub failure: Option<String>,
+    /// The quality report of each body prepared from a mesh or an outline, by body name;
+    /// absent when no body was prepared.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub prepared: std::collections::BTreeMap<String, crate::linkage::prepare::PrepareReport>,
 }
 
 /// Components of a vector for a body of dimension `d` (2 or 3).

@@ -162,6 +162,10 @@ pub struct BodySpec {
     pub cylindrical_shell: Option<ShellSpec>,
     /// Generated 3D box lattice.
     pub box_lattice: Option<LatticeSpec>,
+    /// A 3D body filled inside a closed triangle mesh (isosurface stuffing).
+    pub mesh: Option<MeshSpec>,
+    /// A 2D body triangulated inside an outline (constrained Delaunay, refined).
+    pub outline: Option<OutlineSpec>,
     /// Translation of the body's nodes (from files or a generator), m: places bodies in a scene.
     pub offset: Option<Vec<Real>>,
     /// Supports.
@@ -260,6 +264,28 @@ pub struct LatticeSpec {
     pub size: [Real; 3],
     /// Cells per direction.
     pub cells: [usize; 3],
+}
+
+/// `mesh = { file, spacing }`: a closed OBJ or STL mesh (m) filled with members.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// The mesh file, relative to the scene file.
+    pub file: String,
+    /// Target member length, m.
+    pub spacing: Real,
+}
+
+/// `outline = { file | points, spacing }`: a 2D polygon with holes (m).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutlineSpec {
+    /// A file of loops (one `x y` per line, a blank line between loops), relative to the scene.
+    pub file: Option<String>,
+    /// The outside loop's points, m (no holes).
+    pub points: Option<Vec<[Real; 2]>>,
+    /// Target member length, m.
+    pub spacing: Real,
 }
 
 /// Which nodes a support or load applies to: exactly one of the selector keys.

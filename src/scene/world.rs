@@ -58,6 +58,8 @@ pub struct World {
     pub pictures: PictureSettings,
     /// The scene file it came from.
     pub source: PathBuf,
+    /// The quality report of each body prepared from a mesh or an outline, by body name.
+    pub prepared: std::collections::BTreeMap<String, crate::linkage::prepare::PrepareReport>,
 }
 
 impl World {

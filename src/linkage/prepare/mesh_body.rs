@@ -33,6 +33,8 @@ pub struct PreparedBody {
     pub geometry: Geometry,
     /// The tetrahedra whose edges are the members (3D; empty in 2D), 0-based node numbers.
     pub cells: Vec<[usize; 4]>,
+    /// The triangles whose edges are the members (2D; empty in 3D), 0-based node numbers.
+    pub triangles: Vec<[usize; 3]>,
     /// Counts, measure and quality.
     pub report: PrepareReport,
 }
@@ -115,6 +117,7 @@ pub fn prepare_mesh(
     Ok(PreparedBody {
         geometry,
         cells,
+        triangles: Vec::new(),
         report,
     })
 }

@@ -2,6 +2,7 @@
 
 pub use self::error::PrepareError;
 pub use self::mesh_body::{prepare_mesh, PreparedBody, MAX_SPACING_FRACTION, MEMORY_LIMIT};
+pub use self::outline::{prepare_outline, MAX_TRIANGLES, MIN_TRIANGLE_ANGLE};
 pub use self::quality::{dihedral_angles, enclosed_volume, PrepareReport};
 pub use self::stuffing::{ALPHA_LONG, ALPHA_SHORT};
 
@@ -9,6 +10,7 @@ mod bcc_lattice;
 mod closed_surface;
 mod error;
 mod mesh_body;
+mod outline;
 mod quality;
 mod stuffing;
 mod tet_mesh;

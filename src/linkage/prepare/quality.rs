@@ -7,7 +7,7 @@ use nalgebra::Vector3;
 use std::fmt;
 
 /// What `linkage prepare` prints and a run's `summary.json` records for a prepared body.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PrepareReport {
     /// 2 or 3.
     pub dimension: usize,
