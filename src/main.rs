@@ -3,7 +3,7 @@
 mod bench_cli;
 
 use anyhow::{bail, Context, Result};
-use bench_cli::{bench, bench_contact, bench_large, bench_read, bench_render};
+use bench_cli::{bench, bench_contact, bench_large, bench_prepare, bench_read, bench_render};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
@@ -121,6 +121,10 @@ enum Command {
         /// Time drawing one frame of a shaded shell instead (see --patches, --size).
         #[arg(long)]
         render: bool,
+        /// Time preparing a body of over 1,000,000 members from a torus mesh instead
+        /// (isosurface stuffing): time and peak memory.
+        #[arg(long)]
+        prepare: bool,
         /// With --render: surface patches of the shell.
         #[arg(long, default_value_t = 100_000)]
         patches: usize,
@@ -231,6 +235,7 @@ fn main() -> ExitCode {
         Command::Bench {
             read: true, cells, ..
         } => bench_read(cells),
+        Command::Bench { prepare: true, .. } => bench_prepare(),
         Command::Bench {
             render: true,
             patches,
