@@ -539,3 +539,22 @@ fn a_run_of_a_prepared_body_records_the_report_in_its_summary() {
         );
     }
 }
+
+#[test]
+fn a_self_intersecting_mesh_is_named_by_its_faces() {
+    // Two closed spheres overlapping: orientation is fine, but their faces cross.
+    let (mut v, mut t) = sphere(0.05, 2);
+    let (v2, t2) = sphere(0.05, 2);
+    let n = v.len();
+    v.extend(v2.iter().map(|p| p + Vector3::new(0.03, 0.0, 0.0)));
+    t.extend(t2.iter().map(|f| f.map(|i| i + n)));
+    let e = prepare_mesh(&v, &t, 0.01).unwrap_err().to_string();
+    assert!(e.contains("cross each other") && e.contains("face "), "{e}");
+    // The same spheres apart are two pieces: prepared (no crossing), but refused as a mechanism.
+    let mut apart = v.clone();
+    for p in &mut apart[n..] {
+        p.x += 0.2;
+    }
+    let e = prepare_mesh(&apart, &t, 0.01).unwrap_err().to_string();
+    assert!(e.contains("falls into 2 pieces"), "{e}");
+}

@@ -1,9 +1,11 @@
-//! A 3D body from a closed triangle mesh: checks before any long work, then isosurface
+//! A 3D body from a closed triangle mesh: checks before any long work (faces without area,
+//! faces crossing each other, spacing, memory), then isosurface
 //! stuffing, the linkage and its quality report.
 
 use super::bcc_lattice::BccLattice;
 use super::closed_surface::ClosedSurface;
 use super::quality::{enclosed_volume, report_3d, PrepareReport};
+use super::self_intersection::check_self_intersection;
 use super::stuffing::stuff;
 use super::tet_mesh::TetMesh;
 use super::PrepareError;
@@ -43,7 +45,7 @@ pub struct PreparedBody {
 /// tetrahedra whose edges, about `spacing` long (m), are the members: isosurface stuffing on
 /// a body-centred cubic lattice of cube side `spacing`. Surface nodes lie on the mesh.
 /// The mesh must already be closed and oriented (see `orient_outward`); this checks
-/// degenerate faces, the spacing against the part's size and the memory estimate first.
+/// degenerate and crossing faces, the spacing against the part's size and the memory estimate first.
 pub fn prepare_mesh(
     vertices: &[Vector3<Real>],
     triangles: &[[usize; 3]],
@@ -71,6 +73,7 @@ pub fn prepare_mesh(
             });
         }
     }
+    check_self_intersection(vertices, triangles)?;
     let volume = enclosed_volume(vertices, triangles);
     if volume.is_nan() || volume <= 1e-12 * diagonal.powi(3) {
         return Err(PrepareError::NoVolume { volume });

@@ -12,5 +12,6 @@ mod error;
 mod mesh_body;
 mod outline;
 mod quality;
+mod self_intersection;
 mod stuffing;
 mod tet_mesh;
