@@ -192,6 +192,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         }
         materials.push(material);
     }
+    let density = densities(&spec).map_err(|(span, e)| at(span, e))?;
     if spec.bodies.is_empty() {
         return Err(at(
             top,
@@ -217,6 +218,8 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
             ));
         }
         body.validate().map_err(|e| at(b.span(), e.to_string()))?;
+        let mut body = body;
+        add_self_weight(&mut body, &spec, &density).map_err(|e| at(0..0, e))?;
         bodies.push(body);
     }
     let contact = contact_settings(spec.contact.as_ref().map(|c| c.get_ref()))
@@ -263,6 +266,45 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         source: path.to_path_buf(),
         prepared,
     })
+}
+
+/// Each material's density (kg/m³), checked: finite and not negative.
+fn densities(
+    spec: &SceneSpec,
+) -> Result<Vec<Option<crate::Real>>, (std::ops::Range<usize>, String)> {
+    spec.materials
+        .iter()
+        .map(|m| match m.get_ref().density {
+            Some(rho) if !(rho.is_finite() && rho >= 0.0) => Err((
+                m.span(),
+                format!(
+                    "material '{}': density = {rho} kg/m³: give a finite density of 0 or more",
+                    m.get_ref().name
+                ),
+            )),
+            d => Ok(d),
+        })
+        .collect()
+}
+
+/// The scene's `gravity` on `body`'s members of a material with a density, as nodal loads
+/// on the linear schedule (full weight at the last step).
+fn add_self_weight(
+    body: &mut Body,
+    spec: &SceneSpec,
+    density: &[Option<crate::Real>],
+) -> Result<(), String> {
+    let Some(g) = &spec.gravity else {
+        return Ok(());
+    };
+    let g =
+        vector(g, body.dimension, "gravity").map_err(|e| format!("body '{}': {e}", body.name))?;
+    if g.iter().any(|v| !v.is_finite()) {
+        return Err(format!("gravity = {g:?}: give finite numbers in m/s²"));
+    }
+    let loads = crate::linkage::self_weight_loads(body, density, g, &Schedule::Linear);
+    body.loads.extend(loads);
+    Ok(())
 }
 
 fn material_from(m: &MaterialSpec) -> Result<Material, String> {

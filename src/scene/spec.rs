@@ -27,6 +27,9 @@ pub struct SceneSpec {
     /// Rigid obstacles.
     #[serde(default)]
     pub obstacles: Vec<Spanned<ObstacleSpec>>,
+    /// Acceleration of gravity, m/s² (one component per dimension): the self-weight of
+    /// members whose material has a `density`, lumped to their end nodes.
+    pub gravity: Option<Vec<Real>>,
 }
 
 /// `[contact]`: penalty and tolerances (see `docs/SCENES.md`).
@@ -128,6 +131,8 @@ pub struct MaterialSpec {
     pub compressive_strength: Option<Real>,
     /// `"elastic"` (default), `"tension_only"` (a cable) or `"compression_only"` (a strut).
     pub behaviour: Option<String>,
+    /// Density ρ, kg/m³: members weigh ρ A L under the scene's `gravity` (none: weightless).
+    pub density: Option<Real>,
 }
 
 /// `[[bodies]]`: where the geometry comes from, its material, supports and loads.

@@ -50,12 +50,8 @@ impl ClosedSurface {
             .iter()
             .map(|t| t.map(|v| v as u32))
             .collect::<Vec<_>>();
-        let mesh = TriMesh::with_flags(points, indices, TriMeshFlags::ORIENTED).map_err(|e| {
-            PrepareError::Unresolved {
-                spacing: snap,
-                problem: format!("cannot be built: the mesh is not usable ({e:?})"),
-            }
-        })?;
+        let mesh = TriMesh::with_flags(points, indices, TriMeshFlags::ORIENTED)
+            .map_err(|e| PrepareError::Mesh(format!("{e:?}")))?;
         Ok(ClosedSurface { mesh, snap })
     }
 

@@ -66,6 +66,11 @@ pub enum PrepareError {
         /// What came out, e.g. "has no members" or "falls into 3 pieces".
         problem: String,
     },
+    /// A mesh the surface queries cannot be built on (parry's reason).
+    #[error(
+        "the mesh cannot be used as a closed surface: {0}: check it is one closed, outward surface"
+    )]
+    Mesh(String),
     /// An outline with a problem: too few points, a crossing, a hole outside the outside loop.
     #[error("outline: {0}")]
     Outline(String),
