@@ -66,3 +66,46 @@ fn a_bad_density_or_gravity_is_named() {
         .loads
         .is_empty());
 }
+
+const PRESSED: &str = r#"
+name = "pressed_box"
+steps = 2
+
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+
+[[bodies]]
+name = "box"
+box_lattice = { size = [0.3, 0.2, 0.1], cells = [3, 2, 2] }
+
+[[bodies.supports]]
+on_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
+fix = ["x", "y", "z"]
+
+[[bodies.pressures]]
+on_plane = { point = [0.0, 0.2, 0.0], normal = [0.0, 1.0, 0.0] }
+pressure = 1e5
+"#;
+
+#[test]
+fn a_pressure_on_one_face_of_a_box_sums_to_p_times_its_area() {
+    let world = build_world(PRESSED, Path::new("pressed_box.toml")).unwrap();
+    let total: nalgebra::Vector3<f64> = world.bodies[0].loads.iter().map(|l| l.force).sum();
+    // 1e5 Pa on the 0.3 m × 0.1 m top face: 3000 N downward.
+    assert!((total.y + 3000.0).abs() < 1e-9, "{total:?}");
+    assert!(total.x.abs() < 1e-9 && total.z.abs() < 1e-9);
+    let everywhere = PRESSED.replace(
+        "on_plane = { point = [0.0, 0.2, 0.0], normal = [0.0, 1.0, 0.0] }\npressure",
+        "inside = { min = [-1.0, -1.0, -1.0], max = [1.0, 1.0, 1.0] }\npressure",
+    );
+    let world = build_world(&everywhere, Path::new("pressed_box.toml")).unwrap();
+    let total: nalgebra::Vector3<f64> = world.bodies[0].loads.iter().map(|l| l.force).sum();
+    assert!(total.norm() < 1e-9, "a closed surface: {total:?}");
+    let none = PRESSED.replace("[0.0, 0.2, 0.0], normal", "[0.0, 0.1, 0.0], normal");
+    let e = build_world(&none, Path::new("pressed_box.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("pressure") && e.contains("no patch"), "{e}");
+}

@@ -11,6 +11,7 @@ use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::prepared_body::prepared_geometry;
+use crate::scene::pressures::add_pressure;
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
 use crate::scene::{OutputSettings, PictureSettings, ResultFormat, World};
@@ -752,6 +753,11 @@ fn build_body(
                 schedule: schedule.clone(),
             });
         }
+    }
+    for p in &spec.pressures {
+        let fail = |m: String| at(p.span(), format!("body '{}': pressure: {m}", spec.name));
+        let schedule = schedule(&p.get_ref().schedule).map_err(fail)?;
+        add_pressure(&mut body, p.get_ref(), schedule).map_err(fail)?;
     }
     Ok(body)
 }

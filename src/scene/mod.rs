@@ -39,6 +39,7 @@ mod obstacles;
 pub mod paper_files;
 mod pictures;
 mod prepared_body;
+mod pressures;
 pub mod publish;
 mod result_format;
 mod results;

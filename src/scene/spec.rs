@@ -179,6 +179,9 @@ pub struct BodySpec {
     /// Nodal loads.
     #[serde(default)]
     pub loads: Vec<Spanned<LoadSpec>>,
+    /// Pressures on surface patches.
+    #[serde(default)]
+    pub pressures: Vec<Spanned<PressureSpec>>,
 }
 
 /// `[bodies.newton]`: convergence settings of the Newton solve (see `docs/SCENES.md`).
@@ -390,6 +393,28 @@ pub struct LoadSpec {
     pub schedule: Option<Vec<Real>>,
 }
 
+/// `[[bodies.pressures]]`: a pressure on every patch whose three nodes the selector chooses.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PressureSpec {
+    /// 1-based node numbers.
+    pub nodes: Option<Vec<i64>>,
+    /// See [`SelectorSpec`].
+    pub nearest: Option<Vec<Real>>,
+    /// See [`SelectorSpec`].
+    pub inside: Option<BoxSpec>,
+    /// See [`SelectorSpec`].
+    pub on_line: Option<LineSpec>,
+    /// See [`SelectorSpec`].
+    pub on_plane: Option<PlaneSpec>,
+    /// See [`SelectorSpec`].
+    pub tolerance: Option<Real>,
+    /// Pressure at full schedule, Pa (positive pushes into the body).
+    pub pressure: Real,
+    /// Factor per step 1..=steps (default: linear ramp).
+    pub schedule: Option<Vec<Real>>,
+}
+
 /// `[output]`: which steps are written, pictures and VTK files.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -441,3 +466,4 @@ macro_rules! selector_of {
 }
 selector_of!(SupportSpec);
 selector_of!(LoadSpec);
+selector_of!(PressureSpec);
