@@ -2,6 +2,7 @@
 //! nodes on the mesh, closed outward patches, dihedral angles, member lengths, a solve without
 //! a mechanism, determinism and bad input named.
 
+use linkage::bench::prepare::torus_mesh;
 use linkage::linkage::prepare::{
     dihedral_angles, enclosed_volume, prepare_mesh, prepare_outline, PreparedBody,
     MIN_TRIANGLE_ANGLE,
@@ -72,29 +73,6 @@ fn sphere(radius: f64, levels: usize) -> (Vec<Vector3<f64>>, Vec<[usize; 3]>) {
             next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
         }
         t = next;
-    }
-    (v, t)
-}
-
-/// A torus about z: tube centre radius `big`, tube radius `small` (m), `n × m` quads split.
-fn torus(big: f64, small: f64, n: usize, m: usize) -> (Vec<Vector3<f64>>, Vec<[usize; 3]>) {
-    let mut v = Vec::new();
-    for i in 0..n {
-        let u = 2.0 * PI * i as f64 / n as f64;
-        for j in 0..m {
-            let w = 2.0 * PI * j as f64 / m as f64;
-            let r = big + small * w.cos();
-            v.push(Vector3::new(r * u.cos(), r * u.sin(), small * w.sin()));
-        }
-    }
-    let id = |i: usize, j: usize| (i % n) * m + (j % m);
-    let mut t = Vec::new();
-    for i in 0..n {
-        for j in 0..m {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            t.push([a, b, c]);
-            t.push([a, c, d]);
-        }
     }
     (v, t)
 }
@@ -246,7 +224,7 @@ fn a_sphere_is_filled_within_two_percent_with_bounded_angles_and_solves() {
 
 #[test]
 fn a_torus_is_filled_within_two_percent_with_bounded_angles_and_solves() {
-    let mesh = torus(0.1, 0.04, 96, 48);
+    let mesh = torus_mesh(0.1, 0.04, 96, 48);
     let p = check_prepared("torus", &mesh, 0.01);
     solve_under_load("torus", &p);
 }
