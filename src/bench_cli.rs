@@ -196,3 +196,19 @@ pub(crate) fn bench_render(patches: usize, size: [u32; 2]) -> Result<()> {
     );
     Ok(())
 }
+
+pub(crate) fn bench_prepare() -> Result<()> {
+    use linkage::bench::prepare::{measure_prepare, RADIUS, SPACING, TUBE};
+    let t = measure_prepare(SPACING).map_err(anyhow::Error::msg)?;
+    println!(
+        "Preparing a torus (radius {RADIUS} m, tube {TUBE} m, {} triangles) at spacing {SPACING} m: isosurface stuffing",
+        t.triangles
+    );
+    println!("{}", t.report);
+    println!(
+        "prepare {:.3} s, peak memory {:.0} MB",
+        t.seconds,
+        t.peak_memory as f64 / 1e6
+    );
+    Ok(())
+}

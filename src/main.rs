@@ -4,7 +4,7 @@ mod batch_cli;
 mod bench_cli;
 
 use anyhow::{bail, Context, Result};
-use bench_cli::{bench, bench_contact, bench_large, bench_read, bench_render};
+use bench_cli::{bench, bench_contact, bench_large, bench_prepare, bench_read, bench_render};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
@@ -101,6 +101,19 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Prepare a body from a closed OBJ/STL mesh (3D) or an outline file (2D): write
+    /// DIR/<stem>.nodes, .links (and .patches) and print the quality report.
+    Prepare {
+        /// A closed triangle mesh (.stl, .obj) or an outline (one "x y" per line, loops
+        /// separated by a blank line; the first the outside, the others holes), m.
+        input: PathBuf,
+        /// Target member length, m.
+        #[arg(long)]
+        spacing: f64,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Time assembly, ordering, factorization and solve on 3D box lattices.
     Bench {
         /// Lattice sizes in cells, e.g. 20x20x40 (default: a series up to over 1,000,000 members).
@@ -146,6 +159,10 @@ enum Command {
         /// Time drawing one frame of a shaded shell instead (see --patches, --size).
         #[arg(long)]
         render: bool,
+        /// Time preparing a body of over 1,000,000 members from a torus mesh instead
+        /// (isosurface stuffing): time and peak memory.
+        #[arg(long)]
+        prepare: bool,
         /// With --render: surface patches of the shell.
         #[arg(long, default_value_t = 100_000)]
         patches: usize,
@@ -273,10 +290,16 @@ fn main() -> ExitCode {
         ),
         Command::Check { scenes } => check_scenes(&scenes),
         Command::Export { scene, out } => export(&scene, &out),
+        Command::Prepare {
+            input,
+            spacing,
+            out,
+        } => prepare(&input, spacing, &out),
         Command::Render(args) => render(&args),
         Command::Bench {
             read: true, cells, ..
         } => bench_read(cells),
+        Command::Bench { prepare: true, .. } => bench_prepare(),
         Command::Bench {
             render: true,
             patches,
@@ -562,6 +585,21 @@ fn print_check(path: &Path, report: &linkage::scene::CheckReport) {
     for w in &report.warnings {
         println!("warn  {}: {w}", path.display());
     }
+}
+
+fn prepare(input: &Path, spacing: f64, out: &Path) -> Result<()> {
+    let body = linkage::scene::prepare_file(input, spacing).map_err(anyhow::Error::msg)?;
+    create_out_folder(out)?;
+    let stem = input
+        .file_stem()
+        .map_or("body".into(), |s| s.to_string_lossy().into_owned());
+    let written = linkage::scene::write_prepared(out, &stem, &body)
+        .with_context(|| format!("cannot write the prepared body into {}", out.display()))?;
+    for path in written {
+        println!("wrote {}", path.display());
+    }
+    println!("{}", body.report);
+    Ok(())
 }
 
 fn export(scene: &Path, out: &Path) -> Result<()> {

@@ -137,7 +137,11 @@ fn bundled_scenes() -> Vec<Scene> {
     names.sort();
     let aux: Vec<&String> = names
         .iter()
-        .filter(|n| n.ends_with(".nodes") || n.ends_with(".links"))
+        .filter(|n| {
+            [".nodes", ".links", ".obj", ".stl", ".txt"]
+                .iter()
+                .any(|e| n.ends_with(e))
+        })
         .collect();
     names
         .iter()

@@ -19,6 +19,8 @@ pub use self::member_response::{member_response, MemberResponse};
 pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
 pub use self::newton::NewtonEquilibrium;
 pub(crate) use self::newton::{lagrange_weights, IncrementSize};
+pub use self::pressure::pressure_loads;
+pub use self::self_weight::self_weight_loads;
 pub use self::solver_choice::{
     IterativeSettings, SolverChoice, SolverSettings, SolverUsed, AUTO_CONTACT_ITERATIVE_DOFS_3D,
     AUTO_ITERATIVE_DOFS_2D, AUTO_ITERATIVE_DOFS_3D,
@@ -44,7 +46,10 @@ mod member_check;
 mod member_response;
 mod member_stiffness;
 mod newton;
+pub mod prepare;
+mod pressure;
 pub mod rigid_modes;
+mod self_weight;
 mod solver_choice;
 mod step_state;
 mod tangent_solver;

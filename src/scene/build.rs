@@ -2,6 +2,7 @@
 
 use crate::contact::Obstacle;
 use crate::linkage::generators;
+use crate::linkage::prepare::PrepareReport;
 use crate::linkage::{
     Behaviour, Body, Dimension, Geometry, Kinematics, Material, Member, NewtonSettings, NodalLoad,
     PathMethod, Schedule, SolverChoice, SolverSettings, Support,
@@ -9,6 +10,8 @@ use crate::linkage::{
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
+use crate::scene::prepared_body::prepared_geometry;
+use crate::scene::pressures::add_pressure;
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
 use crate::scene::{OutputSettings, PictureSettings, ResultFormat, World};
@@ -190,6 +193,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         }
         materials.push(material);
     }
+    let density = densities(&spec).map_err(|(span, e)| at(span, e))?;
     if spec.bodies.is_empty() {
         return Err(at(
             top,
@@ -198,8 +202,13 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     }
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut bodies: Vec<Body> = Vec::new();
+    let mut prepared = std::collections::BTreeMap::new();
     for b in &spec.bodies {
-        let body = build_body(b, &materials, (text, path), spec.steps, &at)?;
+        let mut report = None;
+        let body = build_body(b, &materials, (text, path), spec.steps, &at, &mut report)?;
+        if let Some(r) = report {
+            prepared.insert(body.name.clone(), r);
+        }
         if bodies.iter().any(|o| o.name == body.name) {
             return Err(at(
                 b.span(),
@@ -210,6 +219,8 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
             ));
         }
         body.validate().map_err(|e| at(b.span(), e.to_string()))?;
+        let mut body = body;
+        add_self_weight(&mut body, &spec, &density).map_err(|e| at(0..0, e))?;
         bodies.push(body);
     }
     let contact = contact_settings(spec.contact.as_ref().map(|c| c.get_ref()))
@@ -255,7 +266,47 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         pictures,
         source: path.to_path_buf(),
         scene_digest: crate::scene::scene_digest(text),
+        prepared,
     })
+}
+
+/// Each material's density (kg/m³), checked: finite and not negative.
+fn densities(
+    spec: &SceneSpec,
+) -> Result<Vec<Option<crate::Real>>, (std::ops::Range<usize>, String)> {
+    spec.materials
+        .iter()
+        .map(|m| match m.get_ref().density {
+            Some(rho) if !(rho.is_finite() && rho >= 0.0) => Err((
+                m.span(),
+                format!(
+                    "material '{}': density = {rho} kg/m³: give a finite density of 0 or more",
+                    m.get_ref().name
+                ),
+            )),
+            d => Ok(d),
+        })
+        .collect()
+}
+
+/// The scene's `gravity` on `body`'s members of a material with a density, as nodal loads
+/// on the linear schedule (full weight at the last step).
+fn add_self_weight(
+    body: &mut Body,
+    spec: &SceneSpec,
+    density: &[Option<crate::Real>],
+) -> Result<(), String> {
+    let Some(g) = &spec.gravity else {
+        return Ok(());
+    };
+    let g =
+        vector(g, body.dimension, "gravity").map_err(|e| format!("body '{}': {e}", body.name))?;
+    if g.iter().any(|v| !v.is_finite()) {
+        return Err(format!("gravity = {g:?}: give finite numbers in m/s²"));
+    }
+    let loads = crate::linkage::self_weight_loads(body, density, g, &Schedule::Linear);
+    body.loads.extend(loads);
+    Ok(())
 }
 
 fn material_from(m: &MaterialSpec) -> Result<Material, String> {
@@ -336,13 +387,15 @@ fn newton_settings(spec: &BodySpec) -> Result<NewtonSettings, String> {
 }
 
 /// Which generator keys a body gives, in the order `disk`, `rectangle`, `cylindrical_shell`,
-/// `box_lattice`.
-fn generated_by(spec: &BodySpec) -> [bool; 4] {
+/// `box_lattice`, `mesh`, `outline`.
+fn generated_by(spec: &BodySpec) -> [bool; 6] {
     [
         spec.disk.is_some(),
         spec.rectangle.is_some(),
         spec.cylindrical_shell.is_some(),
         spec.box_lattice.is_some(),
+        spec.mesh.is_some(),
+        spec.outline.is_some(),
     ]
 }
 
@@ -362,6 +415,7 @@ fn build_body(
     (text, scene): (&str, &Path),
     steps: usize,
     at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
+    report: &mut Option<PrepareReport>,
 ) -> Result<Body, SceneError> {
     let folder = scene.parent().unwrap_or(Path::new("."));
     let spec = spanned.get_ref();
@@ -466,7 +520,7 @@ fn build_body(
     let from_files = spec.nodes.is_some() || spec.links.is_some();
     if generated + usize::from(from_files) != 1 {
         return Err(here(
-            "give the geometry either as files (`nodes` and `links`, optionally `patches`) or as exactly one generator (`disk`, `rectangle`, `cylindrical_shell`, `box_lattice`)".to_string(),
+            "give the geometry either as files (`nodes` and `links`, optionally `patches`) or as exactly one generator (`disk`, `rectangle`, `cylindrical_shell`, `box_lattice`, `mesh`, `outline`)".to_string(),
         ));
     }
     let mut body = Body::new(&spec.name, Dimension::Two);
@@ -522,7 +576,11 @@ fn build_body(
                 "`patches` goes with `nodes` and `links` files, not with a generator".to_string(),
             ));
         }
-        let geometry: Geometry = if let Some(g) = &spec.disk {
+        let prepared = prepared_geometry(spec, folder).map_err(&here)?;
+        let geometry: Geometry = if let Some(p) = prepared {
+            *report = Some(p.report);
+            Ok(p.geometry)
+        } else if let Some(g) = &spec.disk {
             generators::disk(g.radius, g.rings, g.sectors)
         } else if let Some(g) = &spec.rectangle {
             generators::rectangle(g.width, g.height, g.cells[0], g.cells[1])
@@ -549,10 +607,17 @@ fn build_body(
             "patches are for 3D bodies; this body's nodes have 2 coordinates".to_string(),
         ));
     }
-    let generator = ["disk", "rectangle", "cylindrical_shell", "box_lattice"]
-        .into_iter()
-        .zip(generated_by(spec))
-        .find_map(|(key, g)| g.then_some(key));
+    let generator = [
+        "disk",
+        "rectangle",
+        "cylindrical_shell",
+        "box_lattice",
+        "mesh",
+        "outline",
+    ]
+    .into_iter()
+    .zip(generated_by(spec))
+    .find_map(|(key, g)| g.then_some(key));
     if let (Some(key), Some((n, v))) = (generator, beyond_bound(&body.nodes)) {
         return Err(here(format!(
             "`{key}` places node {} at the coordinate {v:e} m, too large to square (lengths and contact forces would overflow): give sizes in metres, within ±{MAX_LENGTH:e}",
@@ -689,6 +754,11 @@ fn build_body(
                 schedule: schedule.clone(),
             });
         }
+    }
+    for p in &spec.pressures {
+        let fail = |m: String| at(p.span(), format!("body '{}': pressure: {m}", spec.name));
+        let schedule = schedule(&p.get_ref().schedule).map_err(fail)?;
+        add_pressure(&mut body, p.get_ref(), schedule).map_err(fail)?;
     }
     Ok(body)
 }

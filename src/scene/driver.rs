@@ -95,6 +95,7 @@ fn run_in(
         phases: PhaseSeconds::default(),
         failure: None,
         scene_digest: world.scene_digest.clone(),
+        prepared: world.prepared.clone(),
     };
     // The stored steps stay in memory only for the writers after the loop that need them.
     let keep = keeps_steps(world, draw);

@@ -8,6 +8,7 @@ pub use self::check::{
 pub use self::driver::{run, run_into, run_until, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
+pub use self::prepared_body::{prepare_file, read_outline, write_prepared};
 pub use self::result_format::{ResultFormat, NPZ_ABOVE_MEMBERS};
 pub use self::results::{
     BodyResult, BodySize, ContactForce, NodeForce, PairForce, PhaseSeconds, StepResult,
@@ -40,6 +41,8 @@ mod npz_files;
 mod obstacles;
 pub mod paper_files;
 mod pictures;
+mod prepared_body;
+mod pressures;
 pub mod publish;
 mod result_format;
 mod results;

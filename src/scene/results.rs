@@ -181,6 +181,10 @@ pub struct Summary {
     /// only when it matches (absent in folders written before it).
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub scene_digest: String,
+    /// The quality report of each body prepared from a mesh or an outline, by body name;
+    /// absent when no body was prepared.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub prepared: std::collections::BTreeMap<String, crate::linkage::prepare::PrepareReport>,
 }
 
 /// Components of a vector for a body of dimension `d` (2 or 3).

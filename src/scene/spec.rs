@@ -31,6 +31,9 @@ pub struct SceneSpec {
     /// a scene read on its own builds with the values written outside it.
     #[serde(default)]
     pub sweep: Option<toml::Value>,
+    /// Acceleration of gravity, m/s² (one component per dimension): the self-weight of
+    /// members whose material has a `density`, lumped to their end nodes.
+    pub gravity: Option<Vec<Real>>,
 }
 
 /// `[contact]`: penalty and tolerances (see `docs/SCENES.md`).
@@ -132,6 +135,8 @@ pub struct MaterialSpec {
     pub compressive_strength: Option<Real>,
     /// `"elastic"` (default), `"tension_only"` (a cable) or `"compression_only"` (a strut).
     pub behaviour: Option<String>,
+    /// Density ρ, kg/m³: members weigh ρ A L under the scene's `gravity` (none: weightless).
+    pub density: Option<Real>,
 }
 
 /// `[[bodies]]`: where the geometry comes from, its material, supports and loads.
@@ -166,6 +171,10 @@ pub struct BodySpec {
     pub cylindrical_shell: Option<ShellSpec>,
     /// Generated 3D box lattice.
     pub box_lattice: Option<LatticeSpec>,
+    /// A 3D body filled inside a closed triangle mesh (isosurface stuffing).
+    pub mesh: Option<MeshSpec>,
+    /// A 2D body triangulated inside an outline (constrained Delaunay, refined).
+    pub outline: Option<OutlineSpec>,
     /// Translation of the body's nodes (from files or a generator), m: places bodies in a scene.
     pub offset: Option<Vec<Real>>,
     /// Supports.
@@ -174,6 +183,9 @@ pub struct BodySpec {
     /// Nodal loads.
     #[serde(default)]
     pub loads: Vec<Spanned<LoadSpec>>,
+    /// Pressures on surface patches.
+    #[serde(default)]
+    pub pressures: Vec<Spanned<PressureSpec>>,
 }
 
 /// `[bodies.newton]`: convergence settings of the Newton solve (see `docs/SCENES.md`).
@@ -264,6 +276,28 @@ pub struct LatticeSpec {
     pub size: [Real; 3],
     /// Cells per direction.
     pub cells: [usize; 3],
+}
+
+/// `mesh = { file, spacing }`: a closed OBJ or STL mesh (m) filled with members.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// The mesh file, relative to the scene file.
+    pub file: String,
+    /// Target member length, m.
+    pub spacing: Real,
+}
+
+/// `outline = { file | points, spacing }`: a 2D polygon with holes (m).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutlineSpec {
+    /// A file of loops (one `x y` per line, a blank line between loops), relative to the scene.
+    pub file: Option<String>,
+    /// The outside loop's points, m (no holes).
+    pub points: Option<Vec<[Real; 2]>>,
+    /// Target member length, m.
+    pub spacing: Real,
 }
 
 /// Which nodes a support or load applies to: exactly one of the selector keys.
@@ -363,6 +397,28 @@ pub struct LoadSpec {
     pub schedule: Option<Vec<Real>>,
 }
 
+/// `[[bodies.pressures]]`: a pressure on every patch whose three nodes the selector chooses.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PressureSpec {
+    /// 1-based node numbers.
+    pub nodes: Option<Vec<i64>>,
+    /// See [`SelectorSpec`].
+    pub nearest: Option<Vec<Real>>,
+    /// See [`SelectorSpec`].
+    pub inside: Option<BoxSpec>,
+    /// See [`SelectorSpec`].
+    pub on_line: Option<LineSpec>,
+    /// See [`SelectorSpec`].
+    pub on_plane: Option<PlaneSpec>,
+    /// See [`SelectorSpec`].
+    pub tolerance: Option<Real>,
+    /// Pressure at full schedule, Pa (positive pushes into the body).
+    pub pressure: Real,
+    /// Factor per step 1..=steps (default: linear ramp).
+    pub schedule: Option<Vec<Real>>,
+}
+
 /// `[output]`: which steps are written, pictures and VTK files.
 #[derive(Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -414,3 +470,4 @@ macro_rules! selector_of {
 }
 selector_of!(SupportSpec);
 selector_of!(LoadSpec);
+selector_of!(PressureSpec);

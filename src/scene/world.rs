@@ -61,6 +61,8 @@ pub struct World {
     /// [`crate::scene::scene_digest`] of the text it was built from (a sweep's variant: its
     /// generated text), written to `summary.json`.
     pub scene_digest: String,
+    /// The quality report of each body prepared from a mesh or an outline, by body name.
+    pub prepared: std::collections::BTreeMap<String, crate::linkage::prepare::PrepareReport>,
 }
 
 impl World {
