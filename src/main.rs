@@ -371,6 +371,15 @@ fn run_scenes(
                         println!("warn  {}: {w}", world.name);
                     }
                 }
+                if !summary.breaks.is_empty() {
+                    println!("      {} member(s) broke", summary.breaks.len());
+                }
+                if let Some(c) = &summary.collapse {
+                    println!(
+                        "      collapse: body '{}' at step {} (load factor {}): breaking member {} left its supported part a mechanism; steps 0-{} written",
+                        c.body, c.step, c.load_factor, c.member, c.step.saturating_sub(1)
+                    );
+                }
             }
             Err(e) => {
                 failed += 1;

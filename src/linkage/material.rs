@@ -25,6 +25,16 @@ impl Behaviour {
     }
 }
 
+/// What happens to a member of a material when its stress reaches the strength.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Failure {
+    /// It is only marked overloaded (the paper's Fig. 6) and keeps carrying load.
+    #[default]
+    Mark,
+    /// It breaks: it carries nothing from then on and its load passes to its neighbours.
+    Break,
+}
+
 /// The material and cross-section of a member: what the paper's `AE` is made of.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -40,6 +50,8 @@ pub struct Material {
     pub compressive_strength: Option<Real>,
     /// Whether members of this material carry tension, compression or both.
     pub behaviour: Behaviour,
+    /// Whether members reaching their strength are marked or break.
+    pub failure: Failure,
 }
 
 impl Material {
@@ -52,6 +64,7 @@ impl Material {
             tensile_strength: None,
             compressive_strength: None,
             behaviour: Behaviour::Elastic,
+            failure: Failure::Mark,
         }
     }
 

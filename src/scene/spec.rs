@@ -128,6 +128,8 @@ pub struct MaterialSpec {
     pub compressive_strength: Option<Real>,
     /// `"elastic"` (default), `"tension_only"` (a cable) or `"compression_only"` (a strut).
     pub behaviour: Option<String>,
+    /// `"mark"` (default: members beyond their strength are only marked) or `"break"`.
+    pub failure: Option<String>,
 }
 
 /// `[[bodies]]`: where the geometry comes from, its material, supports and loads.
