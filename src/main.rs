@@ -3,7 +3,7 @@
 mod bench_cli;
 
 use anyhow::{bail, Context, Result};
-use bench_cli::{bench, bench_contact, bench_large, bench_read, bench_render};
+use bench_cli::{bench, bench_contact, bench_fracture, bench_large, bench_read, bench_render};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
@@ -105,6 +105,14 @@ enum Command {
         /// With --contact: solve the lattice with the direct solver.
         #[arg(long, requires = "contact")]
         direct: bool,
+        /// Fracture instead: members of a 3D lattice (default 20x20x20 cells, 108,860 members)
+        /// breaking one after another with the factorization kept and corrected, against one
+        /// factorization and against refactoring at every break.
+        #[arg(long)]
+        fracture: bool,
+        /// With --fracture: members to break (default 1000).
+        #[arg(long, requires = "fracture")]
+        breaks: Option<usize>,
         /// Time drawing one frame of a shaded shell instead (see --patches, --size).
         #[arg(long)]
         render: bool,
@@ -219,6 +227,12 @@ fn main() -> ExitCode {
             size,
             ..
         } => bench_render(patches, size),
+        Command::Bench {
+            cells,
+            fracture: true,
+            breaks,
+            ..
+        } => bench_fracture(cells, breaks),
         Command::Bench {
             cells,
             contact: true,

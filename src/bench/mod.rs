@@ -1,6 +1,7 @@
-//! `linkage bench`: lattice, large-displacement, contact, render and file-reading benchmarks.
+//! `linkage bench`: lattice, large-displacement, contact, fracture, render and file-reading benchmarks.
 
 pub mod contact;
+pub mod fracture;
 pub mod large;
 pub mod lattice;
 pub mod read;

@@ -24,6 +24,7 @@ use crate::linkage::{
 };
 use crate::Real;
 use nalgebra::Vector3;
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// Breaks between refactorizations of `K_ff` by default: the Woodbury correction of a solve
@@ -33,6 +34,10 @@ pub const DEFAULT_REFACTOR_EVERY: usize = 64;
 /// A break whose `1 − k gᵀ K⁻¹ g` is at most this leaves `K_ff` singular: a piece falls off
 /// or the structure collapses.
 const SINGULAR_RATIO: Real = 1e-9;
+
+/// Per member its tensile and compressive strength (Pa, positive, infinite for none), or
+/// `None` when it does not break.
+pub type MemberLimits = Vec<Option<(Real, Real)>>;
 
 /// The linear equilibrium of a body with breaking members (see the module documentation).
 pub struct BreakingEquilibrium {
@@ -52,9 +57,11 @@ pub struct BreakingEquilibrium {
     /// Per member `A E / L`, N/m; 0 once broken or fallen off.
     stiffness: Vec<Real>,
     axes: Vec<Vector3<Real>>,
+    /// Per member its undeformed length, m.
+    lengths: Vec<Real>,
     /// Per member its tensile and compressive strength (Pa, infinite for none) when its
     /// material breaks.
-    limits: Vec<Option<(Real, Real)>>,
+    limits: MemberLimits,
     patterns: Vec<LoadPattern>,
     /// Members broken so far, in order.
     broken: Vec<usize>,
@@ -85,7 +92,7 @@ impl BreakingEquilibrium {
 
     /// [`BreakingEquilibrium::new`] with each member's strengths given (tensile, compressive,
     /// Pa; `None`: the member does not break), e.g. drawn with scatter.
-    pub fn with_limits(body: &Body, limits: Vec<Option<(Real, Real)>>) -> Result<Self, SolveError> {
+    pub fn with_limits(body: &Body, limits: MemberLimits) -> Result<Self, SolveError> {
         body.validate()?;
         let t = Instant::now();
         let dofs = DofMap::new(body);
@@ -103,6 +110,9 @@ impl BreakingEquilibrium {
             .iter()
             .map(|m| undeformed_axis(body, m.nodes[0], m.nodes[1]))
             .collect();
+        let lengths = (0..body.members.len())
+            .map(|m| body.member_length(m))
+            .collect();
         let mut supported_node = vec![false; body.nodes.len()];
         for &dof in &dofs.supported {
             supported_node[dof / dofs.dofs_per_node] = true;
@@ -119,6 +129,7 @@ impl BreakingEquilibrium {
             update: LowRankUpdate::new(n, SINGULAR_RATIO),
             stiffness,
             axes,
+            lengths,
             limits,
             patterns: Vec::new(),
             broken: Vec::new(),
@@ -291,23 +302,36 @@ impl BreakingEquilibrium {
         let d = self.dofs.dofs_per_node;
         let u0 = self.combine(f0, |p| &p.displacements);
         let u1 = self.combine(f1, |p| &p.displacements);
+        let start_unloaded = f0.iter().all(|&f| f == 0.0);
+        // Each member's critical fraction on its own (in parallel: no sums cross members),
+        // then the smallest found in member order, so the answer does not depend on threads.
+        let fractions: Vec<Option<Real>> = (0..body.members.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|m| {
+                let (tensile, compressive) = self.limits[m]?;
+                if self.stiffness[m] == 0.0 {
+                    return None;
+                }
+                let member = &body.members[m];
+                let material = &body.materials[member.material];
+                // The stress as the step's results report it (E A ε / A).
+                let stress = |u: &[Real]| {
+                    let strain =
+                        linear_stretch(u, d, member.nodes, &self.axes[m]) / self.lengths[m];
+                    material.youngs_modulus * strain * material.area / material.area
+                };
+                let end = stress(&u1);
+                if end <= tensile && end >= -compressive {
+                    return None;
+                }
+                let a = if start_unloaded { 0.0 } else { stress(&u0) };
+                critical_fraction(a, end - a, tensile, compressive)
+            })
+            .collect();
         let mut best: Option<BreakEvent> = None;
-        for (m, member) in body.members.iter().enumerate() {
-            let Some((tensile, compressive)) = self.limits[m] else {
-                continue;
-            };
-            if self.stiffness[m] == 0.0 {
-                continue;
-            }
-            let material = &body.materials[member.material];
-            let length = body.member_length(m);
-            // The stress as the step's results report it (E A ε / A).
-            let stress = |u: &[Real]| {
-                let strain = linear_stretch(u, d, member.nodes, &self.axes[m]) / length;
-                material.youngs_modulus * strain * material.area / material.area
-            };
-            let (a, end) = (stress(&u0), stress(&u1));
-            if let Some(t) = critical_fraction(a, end - a, tensile, compressive) {
+        for (m, t) in fractions.into_iter().enumerate() {
+            if let Some(t) = t {
                 if best.is_none_or(|b| t < b.fraction) {
                     best = Some(BreakEvent {
                         member: m,
@@ -435,6 +459,43 @@ impl BreakingEquilibrium {
         )
     }
 
+    /// Break the next member the load of `step` (of `steps`) breaks, if any, and return its
+    /// event; pieces that fall off are appended to `fallen`. [`SolveError::Collapse`] (its
+    /// `breaks` holding this event alone) when the break leaves the supported part a mechanism.
+    pub fn next_event(
+        &mut self,
+        body: &Body,
+        step: usize,
+        steps: usize,
+        fallen: &mut Vec<FallenPiece>,
+    ) -> Result<Option<BreakEvent>, SolveError> {
+        if step == 0 {
+            return Ok(None);
+        }
+        let factors = |s: usize| -> Vec<Real> {
+            self.patterns
+                .iter()
+                .map(|p| p.schedule.factor(s, steps))
+                .collect()
+        };
+        let (f0, f1) = (factors(step - 1), factors(step));
+        let Some(event) = self.next_break(body, &f0, &f1) else {
+            return Ok(None);
+        };
+        match self.break_member(body, event.member) {
+            Ok(pieces) => {
+                fallen.extend(pieces);
+                Ok(Some(event))
+            }
+            Err(()) => Err(SolveError::Collapse {
+                body: body.name.clone(),
+                step,
+                member: event.member,
+                breaks: vec![event],
+            }),
+        }
+    }
+
     /// The state at `step` of `steps` after every break the step's load causes (step 0:
     /// undeformed, unloaded). Steps are meant to come in order: the increment is from step
     /// `step − 1`'s loads. [`SolveError::Collapse`] when a break leaves the supported part a
@@ -446,30 +507,25 @@ impl BreakingEquilibrium {
         steps: usize,
     ) -> Result<StepState, SolveError> {
         let mut fracture = FractureState::default();
-        if step > 0 {
-            let f0: Vec<Real> = self
-                .patterns
-                .iter()
-                .map(|p| p.schedule.factor(step - 1, steps))
-                .collect();
-            let f1: Vec<Real> = self
-                .patterns
-                .iter()
-                .map(|p| p.schedule.factor(step, steps))
-                .collect();
-            while let Some(event) = self.next_break(body, &f0, &f1) {
-                fracture.breaks.push(event);
-                match self.break_member(body, event.member) {
-                    Ok(pieces) => fracture.fallen.extend(pieces),
-                    Err(()) => {
-                        return Err(SolveError::Collapse {
-                            body: body.name.clone(),
-                            step,
-                            member: event.member,
-                            breaks: fracture.breaks,
-                        })
-                    }
+        loop {
+            match self.next_event(body, step, steps, &mut fracture.fallen) {
+                Ok(Some(event)) => fracture.breaks.push(event),
+                Ok(None) => break,
+                Err(SolveError::Collapse {
+                    body,
+                    step,
+                    member,
+                    breaks,
+                }) => {
+                    fracture.breaks.extend(breaks);
+                    return Err(SolveError::Collapse {
+                        body,
+                        step,
+                        member,
+                        breaks: fracture.breaks,
+                    });
                 }
+                Err(e) => return Err(e),
             }
         }
         fracture.broken = self.broken.clone();

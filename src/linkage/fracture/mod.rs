@@ -1,6 +1,6 @@
 //! Members that break (sequentially linear analysis, event by event): the critical load of a member, pieces that fall off, and the linear solver that breaks members without refactoring.
 
-pub use self::breaking_equilibrium::BreakingEquilibrium;
+pub use self::breaking_equilibrium::{BreakingEquilibrium, MemberLimits, DEFAULT_REFACTOR_EVERY};
 pub use self::critical::critical_fraction;
 pub use self::events::{breaks_members, BreakEvent, FallenPiece, FractureState};
 pub use self::pieces::unsupported_pieces;
