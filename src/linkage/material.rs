@@ -35,6 +35,16 @@ pub enum Failure {
     Break,
 }
 
+/// Scatter of the members' strengths: each member's strength is the material's times a factor
+/// drawn from a Weibull law of unit scale, `F(x) = 1 − exp(−x^m)`, `m` the Weibull modulus.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scatter {
+    /// The Weibull modulus m (shape): larger is less scatter; finite and > 0.
+    pub weibull_modulus: Real,
+    /// Seed of the generator (ChaCha8): the same seed draws the same strengths everywhere.
+    pub seed: u64,
+}
+
 /// The material and cross-section of a member: what the paper's `AE` is made of.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -52,6 +62,8 @@ pub struct Material {
     pub behaviour: Behaviour,
     /// Whether members reaching their strength are marked or break.
     pub failure: Failure,
+    /// Scatter of the strengths of breaking members (none: every member has the strength).
+    pub scatter: Option<Scatter>,
 }
 
 impl Material {
@@ -65,6 +77,7 @@ impl Material {
             compressive_strength: None,
             behaviour: Behaviour::Elastic,
             failure: Failure::Mark,
+            scatter: None,
         }
     }
 
@@ -110,6 +123,14 @@ impl Material {
                         "{key} = {v} must be a finite positive number of Pa"
                     ));
                 }
+            }
+        }
+        if let Some(scatter) = self.scatter {
+            if !positive(scatter.weibull_modulus) {
+                return Some(format!(
+                    "scatter.weibull_modulus = {} must be a finite positive number",
+                    scatter.weibull_modulus
+                ));
             }
         }
         None

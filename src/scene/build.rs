@@ -4,7 +4,7 @@ use crate::contact::Obstacle;
 use crate::linkage::generators;
 use crate::linkage::{
     Behaviour, Body, Dimension, Failure, Geometry, Kinematics, Material, Member, NewtonSettings,
-    NodalLoad, PathMethod, Schedule, SolverChoice, SolverSettings, Support,
+    NodalLoad, PathMethod, Scatter, Schedule, SolverChoice, SolverSettings, Support,
 };
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::obstacles::{contact_settings, obstacle_from};
@@ -296,6 +296,10 @@ fn material_from(m: &MaterialSpec) -> Result<Material, String> {
                 ))
             }
         },
+        scatter: m.scatter.as_ref().map(|s| Scatter {
+            weibull_modulus: s.weibull_modulus,
+            seed: s.seed,
+        }),
         failure: match m.failure.as_deref() {
             None | Some("mark") => Failure::Mark,
             Some("break") => Failure::Break,
@@ -307,6 +311,12 @@ fn material_from(m: &MaterialSpec) -> Result<Material, String> {
             }
         },
     };
+    if material.scatter.is_some() && material.failure != Failure::Break {
+        return Err(format!(
+            "material '{}': scatter is for breaking members: add failure = \"break\" or remove scatter",
+            m.name
+        ));
+    }
     if material.failure == Failure::Break
         && material.tensile_strength.is_none()
         && material.compressive_strength.is_none()

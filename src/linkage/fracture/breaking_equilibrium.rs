@@ -14,12 +14,13 @@
 use crate::linalg::{CholeskyError, LowRankUpdate, SparseCholesky};
 use crate::linkage::body_state::{linear_internal_forces, linear_stretch, undeformed_axis};
 use crate::linkage::fracture::{
-    critical_fraction, unsupported_pieces, BreakEvent, FallenPiece, FractureState,
+    critical_fraction, member_limits, unsupported_pieces, BreakEvent, FallenPiece, FractureState,
 };
 use crate::linkage::load_patterns::{solve_load_patterns, LoadPattern};
 use crate::linkage::mechanism::diagnose_mechanism;
+use crate::linkage::step_state::{force_scale, free_out_of_balance};
 use crate::linkage::{
-    axial_stiffness, member_block, post_process, Body, DofMap, DofSlot, Failure, PhaseTimes,
+    axial_stiffness, member_block, post_process, Body, Convergence, DofMap, DofSlot, PhaseTimes,
     SolveError, StepState, StiffnessAssembly,
 };
 use crate::Real;
@@ -32,8 +33,11 @@ use std::time::Instant;
 pub const DEFAULT_REFACTOR_EVERY: usize = 64;
 
 /// A break whose `1 − k gᵀ K⁻¹ g` is at most this leaves `K_ff` singular: a piece falls off
-/// or the structure collapses.
-const SINGULAR_RATIO: Real = 1e-9;
+/// or the structure collapses. Not far below 1: a part left on a hinge is singular only up to
+/// the rounding of the factor, and passing it on gives displacements of no meaning; a member
+/// whose removal makes the body a million times more flexible along its axis is taken to hold
+/// a mechanism.
+const SINGULAR_RATIO: Real = 1e-6;
 
 /// Per member its tensile and compressive strength (Pa, positive, infinite for none), or
 /// `None` when it does not break.
@@ -72,21 +76,9 @@ pub struct BreakingEquilibrium {
 
 impl BreakingEquilibrium {
     /// Validate, assemble, factor and solve every load pattern of the (linear) `body`, each
-    /// member's strength from its material.
+    /// member's strength from its material (scattered when it has `scatter`).
     pub fn new(body: &Body) -> Result<Self, SolveError> {
-        let limits = body
-            .members
-            .iter()
-            .map(|m| {
-                let mat = &body.materials[m.material];
-                (mat.failure == Failure::Break).then(|| {
-                    (
-                        mat.tensile_strength.unwrap_or(Real::INFINITY),
-                        mat.compressive_strength.unwrap_or(Real::INFINITY),
-                    )
-                })
-            })
-            .collect();
+        let limits = member_limits(body);
         Self::with_limits(body, limits)
     }
 
@@ -174,7 +166,7 @@ impl BreakingEquilibrium {
     }
 
     /// Fill `K_ff` with the intact members; a free DOF of a node left without members is held
-    /// by a unit diagonal (it carries no load and stays in place).
+    /// by a diagonal entry (it carries no load and stays in place).
     fn fill(&mut self, body: &Body) {
         let stiffness = &self.stiffness;
         self.assembly.fill(
@@ -191,11 +183,14 @@ impl BreakingEquilibrium {
                 member.nodes.iter().for_each(|&n| has_member[n] = true);
             }
         }
+        // The hold is as stiff as the stiffest member, so the factor's pivot test does not
+        // take it for a singular pivot.
+        let hold = self.stiffness.iter().copied().fold(0.0, Real::max).max(1.0);
         let d = self.dofs.dofs_per_node;
         for (node, _) in has_member.iter().enumerate().filter(|(_, h)| !**h) {
             for dir in 0..d {
                 if let Some(place) = self.assembly.diagonal_place(node, dir) {
-                    self.values[place] = 1.0;
+                    self.values[place] = hold;
                 }
             }
         }
@@ -552,6 +547,14 @@ impl BreakingEquilibrium {
         let mut state = post_process(body, &self.dofs, &u, &forces, &internal, members);
         state.iterations = usize::from(step > 0);
         state.fracture = Some(fracture);
+        // Once a body has split, its parts may carry next to nothing (each moved rigidly by
+        // its supports): the residual is taken relative to the member forces the displacements
+        // could give as well, k_max |u|_max, so rounding in them is not read as an error.
+        let umax = u.iter().fold(0.0, |m: Real, v| m.max(v.abs()));
+        let kmax = self.stiffness.iter().copied().fold(0.0, Real::max);
+        let scale = force_scale(&self.dofs, &forces, &internal).max(kmax * umax);
+        state.residual =
+            Convergence::relative(free_out_of_balance(&self.dofs, &forces, &internal), scale);
         if !state.residual.is_finite() || state.residual > 1e-6 {
             return Err(SolveError::Inaccurate {
                 body: body.name.clone(),

@@ -4,8 +4,10 @@ pub use self::breaking_equilibrium::{BreakingEquilibrium, MemberLimits, DEFAULT_
 pub use self::critical::critical_fraction;
 pub use self::events::{breaks_members, BreakEvent, FallenPiece, FractureState};
 pub use self::pieces::unsupported_pieces;
+pub use self::scatter::{member_limits, weibull_factors};
 
 mod breaking_equilibrium;
 mod critical;
 mod events;
 mod pieces;
+mod scatter;
