@@ -21,6 +21,16 @@ pub(crate) fn bench_contact(
     Ok(())
 }
 
+pub(crate) fn bench_fracture(cells: Vec<[usize; 3]>, breaks: Option<usize>) -> Result<()> {
+    let cells = cells.first().copied().unwrap_or([20, 20, 20]);
+    let breaks = breaks.unwrap_or(1000);
+    println!("3D box lattice pulled at its top face, members breaking one after another in one load step");
+    let t = linkage::bench::fracture::measure_fracture(cells, breaks, 10)
+        .map_err(anyhow::Error::msg)?;
+    println!("{}", linkage::bench::fracture::format_fracture(&t));
+    Ok(())
+}
+
 pub(crate) fn bench_large(
     cells: Vec<[usize; 3]>,
     force: Option<f64>,

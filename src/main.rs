@@ -4,7 +4,9 @@ mod batch_cli;
 mod bench_cli;
 
 use anyhow::{bail, Context, Result};
-use bench_cli::{bench, bench_contact, bench_large, bench_prepare, bench_read, bench_render};
+use bench_cli::{
+    bench, bench_contact, bench_fracture, bench_large, bench_prepare, bench_read, bench_render,
+};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
@@ -156,6 +158,14 @@ enum Command {
         /// With --contact: solve the lattice with the direct solver.
         #[arg(long, requires = "contact")]
         direct: bool,
+        /// Fracture instead: members of a 3D lattice (default 20x20x20 cells, 108,860 members)
+        /// breaking one after another with the factorization kept and corrected, against one
+        /// factorization and against refactoring at every break.
+        #[arg(long)]
+        fracture: bool,
+        /// With --fracture: members to break (default 1000).
+        #[arg(long, requires = "fracture")]
+        breaks: Option<usize>,
         /// Time drawing one frame of a shaded shell instead (see --patches, --size).
         #[arg(long)]
         render: bool,
@@ -306,6 +316,12 @@ fn main() -> ExitCode {
             size,
             ..
         } => bench_render(patches, size),
+        Command::Bench {
+            cells,
+            fracture: true,
+            breaks,
+            ..
+        } => bench_fracture(cells, breaks),
         Command::Bench {
             cells,
             contact: true,
@@ -486,6 +502,15 @@ fn run_scenes(
                     for w in &step.warnings {
                         println!("warn  {}: {w}", world.name);
                     }
+                }
+                if !summary.breaks.is_empty() {
+                    println!("      {} member(s) broke", summary.breaks.len());
+                }
+                if let Some(c) = &summary.collapse {
+                    println!(
+                        "      collapse: body '{}' at step {} (load factor {}): breaking member {} left its supported part a mechanism; steps 0-{} written",
+                        c.body, c.step, c.load_factor, c.member, c.step.saturating_sub(1)
+                    );
                 }
             }
             Ran::Failed(msg) => {

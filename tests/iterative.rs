@@ -50,12 +50,12 @@ fn bundled_scenes_agree_with_the_direct_solver() {
     for path in scenes {
         let mut world = load_scene(&path).unwrap();
         // Arc-length paths need a factorization; contact scenes solve all bodies in one
-        // coupled Newton system that is factored directly.
+        // coupled Newton system that is factored directly; breaking bodies keep their factor.
         if world.has_contact()
-            || world
-                .bodies
-                .iter()
-                .any(|b| b.newton.path != linkage::linkage::PathMethod::Schedules)
+            || world.bodies.iter().any(|b| {
+                b.newton.path != linkage::linkage::PathMethod::Schedules
+                    || linkage::linkage::fracture::breaks_members(b)
+            })
         {
             continue;
         }

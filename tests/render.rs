@@ -49,6 +49,7 @@ fn square() -> (ModelFile, StepResult) {
             reactions: vec![],
             loads: vec![],
             contacts: vec![],
+            fracture: None,
         }],
     };
     (model, step)
@@ -181,6 +182,7 @@ fn two_patches() -> (ModelFile, StepResult) {
             reactions: vec![],
             loads: vec![],
             contacts: vec![],
+            fracture: None,
         }],
     };
     (model, step)

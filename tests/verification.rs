@@ -325,7 +325,13 @@ fn every_bundled_scene_is_in_equilibrium() {
         let world = load_scene(&path).unwrap();
         let mut sim = Simulation::new(&world).unwrap();
         for step in 0..=world.steps {
-            let (result, summary) = sim.step(step).unwrap();
+            // A structure that collapses (paper_fracture) ends its run there: the steps before
+            // it are checked.
+            let (result, summary) = match sim.step(step) {
+                Ok(solved) => solved,
+                Err(linkage::scene::RunError::Collapse { .. }) => break,
+                Err(e) => panic!("{}: {e}", path.display()),
+            };
             let mut total = [0.0f64; 3];
             let mut scale = 0.0f64;
             for b in &result.bodies {

@@ -1,6 +1,7 @@
-//! `linkage bench`: lattice, large-displacement, contact, render, file-reading and preparation benchmarks.
+//! `linkage bench`: lattice, large-displacement, contact, fracture, render, file-reading and preparation benchmarks.
 
 pub mod contact;
+pub mod fracture;
 pub mod large;
 pub mod lattice;
 pub mod prepare;

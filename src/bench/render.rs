@@ -94,6 +94,7 @@ pub fn bent_shell(rings: usize, sectors: usize) -> Result<(ModelFile, Vec<StepRe
                     })
                     .collect(),
                 contacts: Vec::new(),
+                fracture: None,
             }],
         }
     };

@@ -209,6 +209,13 @@ impl StiffnessAssembly {
         }
     }
 
+    /// The place in the value array of `K_ff`'s diagonal entry of `node`'s direction `dir`,
+    /// if that DOF is free (to hold a DOF that lost every member).
+    pub fn diagonal_place(&self, node: usize, dir: usize) -> Option<usize> {
+        let place = self.diagonal[node][4 * dir];
+        (place != NOT_FREE).then_some(place as usize)
+    }
+
     /// `y = K_ff x` from the stored lower triangle (for checks; the solves use the factor).
     pub fn multiply(&self, values: &[Real], x: &[Real], y: &mut [Real]) {
         y.iter_mut().for_each(|v| *v = 0.0);

@@ -1,5 +1,6 @@
 //! The solver a body needs: the paper's linear superposition, or Newton for a nonlinear body.
 
+use crate::linkage::fracture::{breaks_members, BreakingEquilibrium};
 use crate::linkage::{
     Body, Equilibrium, NewtonEquilibrium, PhaseTimes, SolveError, SolverUsed, StepState,
 };
@@ -11,12 +12,24 @@ pub enum BodySolver {
     /// Large kinematics, cables or struts, or an arc-length path: Newton step by step, holding
     /// the current state between steps.
     Nonlinear(Box<NewtonEquilibrium>),
+    /// Linear, with members that break: factor once, break members event by event.
+    Breaking(Box<BreakingEquilibrium>),
 }
 
 impl BodySolver {
     /// Validate `body` and prepare its solver (for a linear body: solve it).
     pub fn new(body: &Body) -> Result<Self, SolveError> {
-        Ok(if body.is_nonlinear() {
+        let breaking = breaks_members(body);
+        if breaking && body.is_nonlinear() {
+            return Err(SolveError::BreakingUnsupported {
+                body: body.name.clone(),
+                reason: "need a linear body, and this one has large kinematics, an arc-length path or tension- or compression-only members".to_string(),
+                remedy: "make the body linear (kinematics = \"linear\", elastic members, path by schedules)".to_string(),
+            });
+        }
+        Ok(if breaking {
+            BodySolver::Breaking(Box::new(BreakingEquilibrium::new(body)?))
+        } else if body.is_nonlinear() {
             BodySolver::Nonlinear(Box::new(NewtonEquilibrium::new(body)?))
         } else {
             BodySolver::Linear(Box::new(Equilibrium::new(body)?))
@@ -34,6 +47,7 @@ impl BodySolver {
         match self {
             BodySolver::Linear(eq) => eq.solve_step(body, step, steps),
             BodySolver::Nonlinear(newton) => newton.solve_step(body, step, steps),
+            BodySolver::Breaking(eq) => eq.solve_step(body, step, steps),
         }
     }
 
@@ -43,6 +57,7 @@ impl BodySolver {
         match self {
             BodySolver::Linear(eq) => eq.solver_used,
             BodySolver::Nonlinear(newton) => newton.solver_used(),
+            BodySolver::Breaking(_) => SolverUsed::Direct,
         }
     }
 
@@ -51,6 +66,7 @@ impl BodySolver {
         match self {
             BodySolver::Linear(eq) => eq.assembly.n,
             BodySolver::Nonlinear(newton) => newton.assembly.n,
+            BodySolver::Breaking(eq) => eq.assembly.n,
         }
     }
 
@@ -59,6 +75,7 @@ impl BodySolver {
         match self {
             BodySolver::Linear(eq) => eq.times,
             BodySolver::Nonlinear(newton) => newton.times,
+            BodySolver::Breaking(eq) => eq.times,
         }
     }
 }

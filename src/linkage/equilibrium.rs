@@ -4,14 +4,14 @@ use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
 use crate::linkage::assembly::ModelTooLarge;
 use crate::linkage::body_state::{linear_internal_forces, linear_stretch, undeformed_axis};
 use crate::linkage::iterative_solver::IterativeSolver;
+use crate::linkage::load_patterns::{solve_load_patterns, LoadPattern};
 use crate::linkage::mechanism::{diagnose_mechanism, Mechanism};
 use crate::linkage::step_state::post_process;
 use crate::linkage::{
-    axial_stiffness, member_block, Body, BodyError, DofMap, Schedule, SolverUsed, StepState,
+    axial_stiffness, member_block, Body, BodyError, DofMap, SolverUsed, StepState,
     StiffnessAssembly,
 };
 use crate::Real;
-use nalgebra::Vector3;
 use std::time::Instant;
 
 /// Wall time of the phases of a linear solve, s.
@@ -89,6 +89,29 @@ pub enum SolveError {
         /// Which numbers, e.g. `"displacements"`.
         quantity: &'static str,
     },
+    /// A break left the supported part of the body a mechanism: the structure collapsed (a
+    /// result of the run, not a failure).
+    #[error("body '{body}' collapsed at step {step}: breaking member {} left its supported part a mechanism", .member + 1)]
+    Collapse {
+        /// Body name.
+        body: String,
+        /// The step (1-based) in which it collapsed.
+        step: usize,
+        /// The member (0-based) whose break made it a mechanism.
+        member: usize,
+        /// The breaks of that step, the last one included.
+        breaks: Vec<crate::linkage::fracture::BreakEvent>,
+    },
+    /// Breaking members are not supported for this body.
+    #[error("body '{body}': members of a material with failure = \"break\" {reason}: use failure = \"mark\" for this body, or {remedy}")]
+    BreakingUnsupported {
+        /// Body name.
+        body: String,
+        /// What the body has that breaking does not support yet.
+        reason: String,
+        /// What to change instead.
+        remedy: String,
+    },
     /// The solve returned a result that does not satisfy equilibrium.
     #[error("body '{body}': the solution misses equilibrium by {residual:e} (relative): the stiffness matrix is too ill-conditioned (members of very different stiffness, or nearly collinear members); check the materials and the geometry")]
     Inaccurate {
@@ -97,17 +120,6 @@ pub enum SolveError {
         /// Relative out-of-balance force.
         residual: Real,
     },
-}
-
-/// The loads and prescribed displacements that share one schedule, and the displacement field
-/// they cause at full value: the linear model lets each step be a sum of these (superposition).
-#[derive(Clone, Debug)]
-struct LoadPattern {
-    schedule: Schedule,
-    /// Applied force per body DOF at full value, N.
-    forces: Vec<Real>,
-    /// Displacement per body DOF at full value, m: prescribed at supported DOFs, solved at free ones.
-    displacements: Vec<Real>,
 }
 
 /// The linear equilibrium of one body (paper Eq. 5–10): `K_ff` assembled and factored once,
@@ -278,61 +290,13 @@ impl Equilibrium {
         )))
     }
 
-    /// Group loads and prescribed displacements by schedule and solve `K_ff U_f = F_f − K_fs U_s`
-    /// (paper Eq. 6 with non-zero `U_s`) once for each group. `solve` replaces a right-hand
-    /// side by its solution, or says it could not (then `None`).
+    /// Every load pattern of `body` solved by `solve` (see [`solve_load_patterns`]).
     fn solve_patterns(
         &self,
         body: &Body,
         solve: &mut dyn FnMut(&mut [Real]) -> bool,
     ) -> Option<Vec<LoadPattern>> {
-        let nd = body.dof_count();
-        let d = self.dofs.dofs_per_node;
-        let mut patterns: Vec<LoadPattern> = Vec::new();
-        let pattern_of = |schedule: &Schedule, patterns: &mut Vec<LoadPattern>| -> usize {
-            if let Some(i) = patterns.iter().position(|p| &p.schedule == schedule) {
-                return i;
-            }
-            patterns.push(LoadPattern {
-                schedule: schedule.clone(),
-                forces: vec![0.0; nd],
-                displacements: vec![0.0; nd],
-            });
-            patterns.len() - 1
-        };
-        for l in &body.loads {
-            let p = pattern_of(&l.schedule, &mut patterns);
-            for dir in 0..d {
-                patterns[p].forces[l.node * d + dir] += l.force[dir];
-            }
-        }
-        for s in &body.supports {
-            if s.displacement == Vector3::zeros() {
-                continue;
-            }
-            let p = pattern_of(&s.schedule, &mut patterns);
-            for dir in 0..d {
-                if s.fixed[dir] {
-                    patterns[p].displacements[s.node * d + dir] = s.displacement[dir];
-                }
-            }
-        }
-        let mut rhs = vec![0.0; self.assembly.n];
-        let mut internal = vec![0.0; nd];
-        for p in &mut patterns {
-            // F_f − K_fs U_s: the internal force of the prescribed displacements alone.
-            linear_internal_forces(body, &self.stiffness, &p.displacements, &mut internal);
-            for (i, &dof) in self.dofs.free.iter().enumerate() {
-                rhs[i] = p.forces[dof] - internal[dof];
-            }
-            if !rhs.is_empty() && !solve(&mut rhs) {
-                return None;
-            }
-            for (i, &dof) in self.dofs.free.iter().enumerate() {
-                p.displacements[dof] = rhs[i];
-            }
-        }
-        Some(patterns)
+        solve_load_patterns(body, &self.dofs, self.assembly.n, &self.stiffness, solve)
     }
 
     /// The state at `step` of `steps` (step 0: undeformed, unloaded).

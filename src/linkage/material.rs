@@ -25,6 +25,26 @@ impl Behaviour {
     }
 }
 
+/// What happens to a member of a material when its stress reaches the strength.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Failure {
+    /// It is only marked overloaded (the paper's Fig. 6) and keeps carrying load.
+    #[default]
+    Mark,
+    /// It breaks: it carries nothing from then on and its load passes to its neighbours.
+    Break,
+}
+
+/// Scatter of the members' strengths: each member's strength is the material's times a factor
+/// drawn from a Weibull law of unit scale, `F(x) = 1 − exp(−x^m)`, `m` the Weibull modulus.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scatter {
+    /// The Weibull modulus m (shape): larger is less scatter; finite and > 0.
+    pub weibull_modulus: Real,
+    /// Seed of the generator (ChaCha8): the same seed draws the same strengths everywhere.
+    pub seed: u64,
+}
+
 /// The material and cross-section of a member: what the paper's `AE` is made of.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -40,6 +60,10 @@ pub struct Material {
     pub compressive_strength: Option<Real>,
     /// Whether members of this material carry tension, compression or both.
     pub behaviour: Behaviour,
+    /// Whether members reaching their strength are marked or break.
+    pub failure: Failure,
+    /// Scatter of the strengths of breaking members (none: every member has the strength).
+    pub scatter: Option<Scatter>,
 }
 
 impl Material {
@@ -52,6 +76,8 @@ impl Material {
             tensile_strength: None,
             compressive_strength: None,
             behaviour: Behaviour::Elastic,
+            failure: Failure::Mark,
+            scatter: None,
         }
     }
 
@@ -97,6 +123,14 @@ impl Material {
                         "{key} = {v} must be a finite positive number of Pa"
                     ));
                 }
+            }
+        }
+        if let Some(scatter) = self.scatter {
+            if !positive(scatter.weibull_modulus) {
+                return Some(format!(
+                    "scatter.weibull_modulus = {} must be a finite positive number",
+                    scatter.weibull_modulus
+                ));
             }
         }
         None

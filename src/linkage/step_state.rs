@@ -44,6 +44,9 @@ pub struct StepState {
     /// iterate differs from the solution by less than the displacement tolerance; always 0 for
     /// a linear body.
     pub negative_pivots: usize,
+    /// Members broken so far and in this step, pieces fallen off: a body with breaking
+    /// members only.
+    pub fracture: Option<crate::linkage::fracture::FractureState>,
 }
 
 /// Build the state from a displacement per body DOF `u` (m), the applied force per body DOF

@@ -4,8 +4,8 @@ use crate::contact::Obstacle;
 use crate::linkage::generators;
 use crate::linkage::prepare::PrepareReport;
 use crate::linkage::{
-    Behaviour, Body, Dimension, Geometry, Kinematics, Material, Member, NewtonSettings, NodalLoad,
-    PathMethod, Schedule, SolverChoice, SolverSettings, Support,
+    Behaviour, Body, Dimension, Failure, Geometry, Kinematics, Material, Member, NewtonSettings,
+    NodalLoad, PathMethod, Scatter, Schedule, SolverChoice, SolverSettings, Support,
 };
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::obstacles::{contact_settings, obstacle_from};
@@ -348,7 +348,36 @@ fn material_from(m: &MaterialSpec) -> Result<Material, String> {
                 ))
             }
         },
+        scatter: m.scatter.as_ref().map(|s| Scatter {
+            weibull_modulus: s.weibull_modulus,
+            seed: s.seed,
+        }),
+        failure: match m.failure.as_deref() {
+            None | Some("mark") => Failure::Mark,
+            Some("break") => Failure::Break,
+            Some(other) => {
+                return Err(format!(
+                    "material '{}': failure = {other:?}: use \"mark\" (overloaded members are only marked) or \"break\" (they break)",
+                    m.name
+                ))
+            }
+        },
     };
+    if material.scatter.is_some() && material.failure != Failure::Break {
+        return Err(format!(
+            "material '{}': scatter is for breaking members: add failure = \"break\" or remove scatter",
+            m.name
+        ));
+    }
+    if material.failure == Failure::Break
+        && material.tensile_strength.is_none()
+        && material.compressive_strength.is_none()
+    {
+        return Err(format!(
+            "material '{}': failure = \"break\" needs a strength: give strength (or tensile_strength, compressive_strength) in Pa",
+            m.name
+        ));
+    }
     match material.problem() {
         Some(p) => Err(format!("material '{}': {p}", m.name)),
         None => Ok(material),

@@ -3,7 +3,7 @@
 
 use crate::scene::check::output_warning;
 use crate::scene::publish::{destination, publish, remove_stale, staging_dir};
-use crate::scene::results::{PhaseSeconds, Summary};
+use crate::scene::results::{PhaseSeconds, Summary, SummaryBreak};
 use crate::scene::run_error::RunError;
 use crate::scene::run_results::step_digits;
 use crate::scene::simulation::Simulation;
@@ -96,6 +96,8 @@ fn run_in(
         failure: None,
         scene_digest: world.scene_digest.clone(),
         prepared: world.prepared.clone(),
+        breaks: Vec::new(),
+        collapse: None,
     };
     // The stored steps stay in memory only for the writers after the loop that need them.
     let keep = keeps_steps(world, draw);
@@ -113,6 +115,13 @@ fn run_in(
         let t = Instant::now();
         let (result, mut line) = match simulation.step(step) {
             Ok(solved) => solved,
+            // A collapse is a result: the summary records it and the run ends there, published
+            // as a complete run.
+            Err(RunError::Collapse { collapse, breaks }) if step > 0 => {
+                summary.breaks.extend(breaks);
+                summary.collapse = Some(collapse);
+                break;
+            }
             // A step after step 0 that cannot be solved ends the run, but the steps before it
             // are kept and the summary says why it stopped.
             Err(e) if step > 0 => {
@@ -123,6 +132,15 @@ fn run_in(
             Err(e) => return Err(e),
         };
         line.seconds = t.elapsed().as_secs_f64() + if step == 1 { setup } else { 0.0 };
+        for b in &result.bodies {
+            let Some(f) = &b.fracture else { continue };
+            summary.breaks.extend(f.breaks.iter().map(|r| SummaryBreak {
+                step,
+                body: b.name.clone(),
+                member: r.member,
+                load_factor: r.load_factor,
+            }));
+        }
         if step == 0 {
             line.warnings.extend(output_warning(world));
         }

@@ -11,8 +11,8 @@ pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::prepared_body::{prepare_file, read_outline, write_prepared};
 pub use self::result_format::{ResultFormat, NPZ_ABOVE_MEMBERS};
 pub use self::results::{
-    BodyResult, BodySize, ContactForce, NodeForce, PairForce, PhaseSeconds, StepResult,
-    StepSummary, Summary,
+    BodyFracture, BodyResult, BodySize, BreakRecord, Collapse, ContactForce, NodeForce, PairForce,
+    PhaseSeconds, StepResult, StepSummary, Summary, SummaryBreak,
 };
 pub use self::run_error::RunError;
 pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS};

@@ -81,6 +81,21 @@ pub(crate) fn step_npz(step: &StepResult, dimensions: &[usize]) -> std::io::Resu
             &[c.len(), d],
             c.iter().flat_map(|c| &c.force),
         )?;
+        if let Some(f) = &b.fracture {
+            out.i64s(&key("broken"), &[f.broken.len()], f.broken.iter().copied())?;
+            let breaks = &f.breaks;
+            out.i64s(
+                &key("breaks_member"),
+                &[breaks.len()],
+                breaks.iter().map(|b| b.member),
+            )?;
+            out.f64s(
+                &key("breaks_load_factor"),
+                &[breaks.len()],
+                breaks.iter().map(|b| &b.load_factor),
+            )?;
+            out.i64s(&key("fallen"), &[f.fallen.len()], f.fallen.iter().copied())?;
+        }
     }
     out.finish()
 }
@@ -176,6 +191,7 @@ pub(crate) fn read_step_npz(bytes: &[u8], model: &ModelFile) -> Result<StepResul
             reactions,
             loads,
             contacts,
+            fracture: None,
         });
     }
     Ok(StepResult {
@@ -400,6 +416,7 @@ mod tests {
                         depth: 1e-6,
                         force: vec![0.0, 2.0],
                     }],
+                    fracture: None,
                 },
                 BodyResult {
                     name: "3d".into(),
@@ -415,6 +432,7 @@ mod tests {
                         force: vec![0.0, 0.0, -10.0],
                     }],
                     contacts: vec![],
+                    fracture: None,
                 },
             ],
         }

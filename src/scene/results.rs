@@ -50,6 +50,58 @@ pub struct BodyResult {
     pub loads: Vec<NodeForce>,
     /// Contact forces per node.
     pub contacts: Vec<ContactForce>,
+    /// `broken`, `breaks` and `fallen`: a body with breaking members only.
+    #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
+    pub fracture: Option<BodyFracture>,
+}
+
+/// One break as written: the member and the load factor at which it broke.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BreakRecord {
+    /// 1-based member number.
+    pub member: usize,
+    /// The load factor (or prescribed-displacement factor) at which it reached its strength:
+    /// below the previous break's in a snap-back.
+    pub load_factor: Real,
+}
+
+/// The fracture fields of a body at one step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BodyFracture {
+    /// 1-based members broken so far, in the order they broke.
+    pub broken: Vec<usize>,
+    /// The breaks of this step, in order.
+    pub breaks: Vec<BreakRecord>,
+    /// 1-based nodes of pieces that fell off in this step (left without support and removed
+    /// from the solve; absent when none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fallen: Vec<usize>,
+}
+
+/// A break as the summary lists it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SummaryBreak {
+    /// The step in which it happened.
+    pub step: usize,
+    /// Body name.
+    pub body: String,
+    /// 1-based member number.
+    pub member: usize,
+    /// Load factor at which it broke.
+    pub load_factor: Real,
+}
+
+/// The collapse of a structure: a break left its supported part a mechanism.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Collapse {
+    /// The step in which it collapsed (not written: it has no equilibrium).
+    pub step: usize,
+    /// Body name.
+    pub body: String,
+    /// Load factor of the last break.
+    pub load_factor: Real,
+    /// 1-based number of the member whose break made it a mechanism.
+    pub member: usize,
 }
 
 /// The total contact force one body receives from one obstacle or other body at a step.
@@ -118,6 +170,9 @@ pub struct StepSummary {
     /// set that did not settle (absent when there is nothing to say).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// Members broken so far, all bodies (absent without breaking members).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub broken: Option<usize>,
 }
 
 /// Size of one body, as reported in `summary.json`.
@@ -185,6 +240,13 @@ pub struct Summary {
     /// absent when no body was prepared.
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub prepared: std::collections::BTreeMap<String, crate::linkage::prepare::PrepareReport>,
+    /// Every break of the run, in order (absent when nothing broke).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub breaks: Vec<SummaryBreak>,
+    /// The structure's collapse, when a break made it a mechanism: the run stopped there with
+    /// the steps before it written (absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collapse: Option<Collapse>,
 }
 
 /// Components of a vector for a body of dimension `d` (2 or 3).
@@ -224,6 +286,7 @@ impl BodyResult {
             reactions: node_forces(&state.reactions),
             loads: node_forces(&state.loads),
             contacts: Vec::new(),
+            fracture: None,
         }
     }
 

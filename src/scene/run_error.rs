@@ -40,6 +40,15 @@ pub enum RunError {
         /// Why the step failed.
         source: Box<RunError>,
     },
+    /// A break made a structure a mechanism: a result, not a failure. The driver records it
+    /// in the summary and ends the run there with the steps before it written.
+    #[error("body '{}' collapsed at step {} (load factor {}): breaking member {} left its supported part a mechanism", .collapse.body, .collapse.step, .collapse.load_factor, .collapse.member)]
+    Collapse {
+        /// The collapse.
+        collapse: crate::scene::results::Collapse,
+        /// The breaks of the collapse step, the last one included.
+        breaks: Vec<crate::scene::results::SummaryBreak>,
+    },
     /// The run was asked to stop (SIGINT, SIGTERM) before it finished; nothing was written.
     #[error("{scene}: interrupted before step {step}: no results written (earlier results of the scene are untouched)")]
     Interrupted {

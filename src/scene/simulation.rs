@@ -2,10 +2,12 @@
 //! and the step's result and summary line.
 
 use crate::contact::{ContactSolver, NodeContact};
+use crate::linkage::fracture::{breaks_members, BreakEvent, FractureState};
 use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
 use crate::scene::instability::InstabilityWatch;
 use crate::scene::results::{
-    BodyResult, BodySize, ContactForce, PairForce, StepResult, StepSummary,
+    BodyFracture, BodyResult, BodySize, BreakRecord, Collapse, ContactForce, PairForce, StepResult,
+    StepSummary, SummaryBreak,
 };
 use crate::scene::run_error::RunError;
 use crate::scene::World;
@@ -34,6 +36,18 @@ pub struct Simulation<'w> {
 impl<'w> Simulation<'w> {
     /// Assemble and factor every body of `world`.
     pub fn new(world: &'w World) -> Result<Self, RunError> {
+        if world.has_contact() {
+            if let Some(body) = world.bodies.iter().find(|b| breaks_members(b)) {
+                return Err(RunError::Solve {
+                    scene: world.source.clone(),
+                    source: SolveError::BreakingUnsupported {
+                        body: body.name.clone(),
+                        reason: "are not supported yet in a scene with contact (obstacles or [contact])".to_string(),
+                        remedy: "solve the body without contact (supports and prescribed displacements instead of obstacles)".to_string(),
+                    },
+                });
+            }
+        }
         let solver = if world.has_contact() {
             let contact = ContactSolver::new(&world.bodies, &world.obstacles, world.contact)
                 .map_err(|source| RunError::Contact {
@@ -104,12 +118,40 @@ impl<'w> Simulation<'w> {
             WorldSolver::Bodies(solvers) => {
                 let mut states = Vec::with_capacity(solvers.len());
                 for (body, solver) in world.bodies.iter().zip(solvers.iter_mut()) {
-                    let state = solver
-                        .solve_step(body, step, world.steps)
-                        .map_err(|source| RunError::Solve {
-                            scene: world.source.clone(),
-                            source,
-                        })?;
+                    let state = match solver.solve_step(body, step, world.steps) {
+                        Ok(state) => state,
+                        Err(SolveError::Collapse {
+                            body,
+                            step,
+                            member,
+                            breaks,
+                        }) => {
+                            let records = self.break_records(&breaks, step);
+                            return Err(RunError::Collapse {
+                                collapse: Collapse {
+                                    step,
+                                    body: body.clone(),
+                                    load_factor: records.last().map_or(0.0, |r| r.load_factor),
+                                    member: member + 1,
+                                },
+                                breaks: records
+                                    .iter()
+                                    .map(|r| SummaryBreak {
+                                        step,
+                                        body: body.clone(),
+                                        member: r.member,
+                                        load_factor: r.load_factor,
+                                    })
+                                    .collect(),
+                            });
+                        }
+                        Err(source) => {
+                            return Err(RunError::Solve {
+                                scene: world.source.clone(),
+                                source,
+                            })
+                        }
+                    };
                     add_newton_counts(&mut summary, &state);
                     states.push(state);
                 }
@@ -146,6 +188,11 @@ impl<'w> Simulation<'w> {
             if let Some(contacts) = contacts.get(k) {
                 written.contacts = contact_forces(body, contacts);
             }
+            if let Some(fracture) = &state.fracture {
+                *summary.broken.get_or_insert(0) += fracture.broken.len();
+                summary.warnings.extend(fallen_warnings(body, fracture));
+                written.fracture = Some(self.body_fracture(fracture, step));
+            }
             result.bodies.push(written);
         }
         let warnings = self
@@ -153,6 +200,36 @@ impl<'w> Simulation<'w> {
             .warnings(&world.bodies, step, &states, &summary.contact_forces);
         summary.warnings.extend(warnings);
         Ok((result, summary))
+    }
+
+    /// The written form of breaks of `step`: 1-based members, the step's fractions of its
+    /// load increment turned into load factors.
+    fn break_records(&self, breaks: &[BreakEvent], step: usize) -> Vec<BreakRecord> {
+        let (from, to) = (
+            self.world.load_factor(step.saturating_sub(1)),
+            self.world.load_factor(step),
+        );
+        breaks
+            .iter()
+            .map(|b| BreakRecord {
+                member: b.member + 1,
+                load_factor: from + b.fraction * (to - from),
+            })
+            .collect()
+    }
+
+    fn body_fracture(&self, fracture: &FractureState, step: usize) -> BodyFracture {
+        let mut fallen: Vec<usize> = fracture
+            .fallen
+            .iter()
+            .flat_map(|p| p.nodes.iter().map(|n| n + 1))
+            .collect();
+        fallen.sort_unstable();
+        BodyFracture {
+            broken: fracture.broken.iter().map(|m| m + 1).collect(),
+            breaks: self.break_records(&fracture.breaks, step),
+            fallen,
+        }
     }
 
     /// Model sizes for the summary.
@@ -220,7 +297,27 @@ fn empty_summary(step: usize, load_factor: Real) -> StepSummary {
         seconds: 0.0,
         warnings: Vec::new(),
         contact_forces: Vec::new(),
+        broken: None,
     }
+}
+
+/// One warning per piece that fell off: its size, its first nodes and the break that released it.
+fn fallen_warnings(body: &Body, fracture: &FractureState) -> Vec<String> {
+    fracture
+        .fallen
+        .iter()
+        .map(|p| {
+            let shown: Vec<String> = p.nodes.iter().take(8).map(|n| (n + 1).to_string()).collect();
+            let more = if p.nodes.len() > 8 { ", …" } else { "" };
+            format!(
+                "body '{}': breaking member {} left a piece of {} node(s) ({}{more}) without support: it fell off and was removed from the solve",
+                body.name,
+                p.member + 1,
+                p.nodes.len(),
+                shown.join(", ")
+            )
+        })
+        .collect()
 }
 
 /// Fold one body's Newton counts into the step's line: iterations (largest, with that body's

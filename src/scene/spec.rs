@@ -137,6 +137,20 @@ pub struct MaterialSpec {
     pub behaviour: Option<String>,
     /// Density ρ, kg/m³: members weigh ρ A L under the scene's `gravity` (none: weightless).
     pub density: Option<Real>,
+    /// `"mark"` (default: members beyond their strength are only marked) or `"break"`.
+    pub failure: Option<String>,
+    /// `{ weibull_modulus, seed }`: each breaking member's strength drawn from a Weibull law.
+    pub scatter: Option<ScatterSpec>,
+}
+
+/// `scatter = { weibull_modulus = 12.0, seed = 7 }` of a breaking material.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScatterSpec {
+    /// Weibull modulus (shape), > 0.
+    pub weibull_modulus: Real,
+    /// Seed of the generator.
+    pub seed: u64,
 }
 
 /// `[[bodies]]`: where the geometry comes from, its material, supports and loads.

@@ -6,7 +6,8 @@
 //! order, body after body, then the patches as triangles (VTK_TRIANGLE = 5). Point data:
 //! `displacement`, `applied_force`, `reaction`, `contact_force` (3 components, m or N) and
 //! `body` (1-based). Cell data: `axial_force` (N), `stress` (Pa), `overloaded` (0/1),
-//! `member` (1-based, 0 on triangles) and `body`. A triangle carries the mean axial force and
+//! `member` (1-based, 0 on triangles) and `body`; with breaking members also `broken` (0/1, 0 on
+//! triangles). A triangle carries the mean axial force and
 //! stress of those of its three edges that are members (0 if none) and `overloaded` = 0.
 //!
 //! A scene with rigid obstacles also gets `vtk/obstacles_NNNN.vtu` per stored step, part 1 of
@@ -134,6 +135,8 @@ struct Cell {
     axial_force: Real,
     stress: Real,
     overloaded: u8,
+    /// 1 for a broken member (written only when a body has breaking members).
+    broken: u8,
     member: usize,
     body: usize,
 }
@@ -192,6 +195,7 @@ pub(crate) fn vtu_file(
         ));
         point_body.extend(std::iter::repeat_n(k + 1, n));
         let overloaded = overloaded_flags(m, r);
+        let broken = broken_flags(m, r);
         let mut member_of: HashMap<(usize, usize), usize> = HashMap::new();
         for (j, e) in m.members.iter().enumerate() {
             member_of.insert((e[0].min(e[1]), e[0].max(e[1])), j);
@@ -201,6 +205,7 @@ pub(crate) fn vtu_file(
                 axial_force: r.axial_forces[j],
                 stress: r.stresses[j],
                 overloaded: overloaded[j],
+                broken: broken[j],
                 member: j + 1,
                 body: k + 1,
             });
@@ -224,6 +229,7 @@ pub(crate) fn vtu_file(
                 axial_force: mean(&r.axial_forces),
                 stress: mean(&r.stresses),
                 overloaded: 0,
+                broken: 0,
                 member: 0,
                 body: k + 1,
             });
@@ -253,6 +259,9 @@ pub(crate) fn vtu_file(
     a.scalars("axial_force", cells.iter().map(|c| c.axial_force));
     a.scalars("stress", cells.iter().map(|c| c.stress));
     a.ints("overloaded", cells.iter().map(|c| c.overloaded as usize));
+    if result.bodies.iter().any(|b| b.fracture.is_some()) {
+        a.ints("broken", cells.iter().map(|c| c.broken as usize));
+    }
     a.ints("member", cells.iter().map(|c| c.member));
     a.ints("body", cells.iter().map(|c| c.body));
     a.xml.push_str("      </CellData>\n      <Points>\n");
@@ -389,6 +398,17 @@ fn xml_attribute(text: &str) -> String {
         }
     }
     s
+}
+
+/// 1 per member broken so far (all 0 for a body without breaking members).
+fn broken_flags(m: &ModelBody, r: &BodyResult) -> Vec<u8> {
+    let mut f = vec![0u8; m.members.len()];
+    for &j in r.fracture.iter().flat_map(|fr| &fr.broken) {
+        if let Some(x) = f.get_mut(j.wrapping_sub(1)) {
+            *x = 1;
+        }
+    }
+    f
 }
 
 fn overloaded_flags(m: &ModelBody, r: &BodyResult) -> Vec<u8> {

@@ -1,0 +1,181 @@
+//! `linkage bench --fracture`: breaking members one after another in a large 3D lattice, with
+//! the factorization kept and corrected (Woodbury) against refactoring at every break.
+
+use crate::bench::lattice::peak_memory;
+use crate::linkage::fracture::{BreakingEquilibrium, MemberLimits};
+use crate::linkage::generators::box_lattice;
+use crate::linkage::{Body, Material, Schedule, Support};
+use crate::Real;
+use nalgebra::Vector3;
+use std::time::Instant;
+
+/// What one fracture benchmark measured.
+#[derive(Clone, Debug)]
+pub struct FractureTiming {
+    /// Lattice cells.
+    pub cells: [usize; 3],
+    /// Nodes and members of the lattice.
+    pub nodes: usize,
+    /// Members of the lattice.
+    pub members: usize,
+    /// Rows of `K_ff`.
+    pub free_dofs: usize,
+    /// Ordering and symbolic factorization, s.
+    pub symbolic_seconds: Real,
+    /// One numeric factorization of the intact lattice, s.
+    pub factor_seconds: Real,
+    /// One solve (forward and back substitution) with it, s.
+    pub solve_seconds: Real,
+    /// Breaks made with the factor kept.
+    pub breaks: usize,
+    /// Their total time, s.
+    pub breaking_seconds: Real,
+    /// Refactorizations among them (every `refactor_every` breaks, and when pieces fell off).
+    pub refactorizations: usize,
+    /// Breaks between refactorizations.
+    pub refactor_every: usize,
+    /// Breaks made refactoring at every break (the comparison).
+    pub compared_breaks: usize,
+    /// Their time per break, s.
+    pub refactor_seconds_per_break: Real,
+    /// Whether both ways broke the same members in the same order, at load fractions equal
+    /// to 1e-9.
+    pub same_sequence: bool,
+    /// Peak resident memory of the process, bytes.
+    pub peak_memory: u64,
+}
+
+/// A strength factor in [1, 3) per member from a fixed integer hash (SplitMix64), the same on
+/// every machine.
+fn scatter(m: usize) -> Real {
+    let mut z = (m as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    1.0 + 2.0 * (z >> 11) as Real / (1u64 << 53) as Real
+}
+
+/// A steel lattice of `cells` cells of 1 cm (members of 1 mm²), bottom face clamped, top face
+/// pulled up 0.5 % of the height; each member breaks in tension at 400 MPa times a factor in
+/// [1, 3) (so about a third of the vertical members would break at the full pull, far more
+/// than measured).
+pub fn fracture_lattice(cells: [usize; 3]) -> Result<(Body, MemberLimits), String> {
+    let h = 0.01;
+    let size = cells.map(|c| c as Real * h);
+    let geometry = box_lattice(size, cells).map_err(|e| e.to_string())?;
+    let mut body = Body::from_geometry("lattice", geometry, Material::new("steel", 200e9, 1e-6));
+    for i in 0..body.nodes.len() {
+        let z = body.nodes[i].z;
+        if z.abs() < 1e-9 {
+            body.supports.push(Support::fixed(i, [true; 3]));
+        } else if (z - size[2]).abs() < 1e-9 {
+            body.supports.push(Support {
+                node: i,
+                fixed: [true; 3],
+                displacement: Vector3::new(0.0, 0.0, 0.005 * size[2]),
+                schedule: Schedule::Linear,
+            });
+        }
+    }
+    let limits = (0..body.members.len())
+        .map(|m| Some((400e6 * scatter(m), Real::INFINITY)))
+        .collect();
+    Ok((body, limits))
+}
+
+/// Break `breaks` members of the lattice of `cells` one by one (one load step), keeping the
+/// factor; then break the first `compare` of them again refactoring at every break.
+pub fn measure_fracture(
+    cells: [usize; 3],
+    breaks: usize,
+    compare: usize,
+) -> Result<FractureTiming, String> {
+    let (body, limits) = fracture_lattice(cells)?;
+    let mut eq =
+        BreakingEquilibrium::with_limits(&body, limits.clone()).map_err(|e| e.to_string())?;
+    let (symbolic, factor, solve) = (eq.times.symbolic, eq.times.numeric, eq.times.solve);
+    let mut fallen = Vec::new();
+    let t = Instant::now();
+    let mut events = Vec::with_capacity(breaks);
+    while events.len() < breaks {
+        match eq.next_event(&body, 1, 1, &mut fallen) {
+            Ok(Some(e)) => events.push(e),
+            Ok(None) => break,
+            Err(e) => return Err(format!("after {} breaks: {e}", events.len())),
+        }
+    }
+    let breaking = t.elapsed().as_secs_f64();
+    let refactorizations = eq.factorizations - 1;
+    let refactor_every = eq.refactor_every;
+    let free_dofs = eq.assembly.n;
+    drop(eq);
+    let mut slow = BreakingEquilibrium::with_limits(&body, limits).map_err(|e| e.to_string())?;
+    slow.refactor_every = 1;
+    let t = Instant::now();
+    let mut same = true;
+    let compared = compare.min(events.len());
+    for expected in &events[..compared] {
+        match slow.next_event(&body, 1, 1, &mut fallen) {
+            Ok(Some(e)) => {
+                same &= e.member == expected.member
+                    && (e.fraction - expected.fraction).abs()
+                        <= 1e-9 * expected.fraction.abs().max(1e-300);
+            }
+            _ => same = false,
+        }
+    }
+    let refactor_per_break = t.elapsed().as_secs_f64() / compared.max(1) as Real;
+    Ok(FractureTiming {
+        cells,
+        nodes: body.nodes.len(),
+        members: body.members.len(),
+        free_dofs,
+        symbolic_seconds: symbolic,
+        factor_seconds: factor,
+        solve_seconds: solve,
+        breaks: events.len(),
+        breaking_seconds: breaking,
+        refactorizations,
+        refactor_every,
+        compared_breaks: compared,
+        refactor_seconds_per_break: refactor_per_break,
+        same_sequence: same,
+        peak_memory: peak_memory(),
+    })
+}
+
+/// The benchmark's table, one quantity a line.
+pub fn format_fracture(t: &FractureTiming) -> String {
+    let per_break = t.breaking_seconds / t.breaks.max(1) as Real;
+    let refactor_total = t.refactor_seconds_per_break * t.breaks as Real;
+    format!(
+        "lattice {}x{}x{} cells: {} nodes, {} members, {} free DOFs\n\
+         ordering + symbolic {:.3} s; one factorization {:.3} s; one solve {:.4} s\n\
+         {} breaks with the factor kept (Woodbury, refactored every {} breaks: {} refactorizations): {:.2} s, {:.4} s a break = {:.1} factorizations' worth\n\
+         refactoring at every break: {:.3} s a break (measured over the first {}), so {:.1} s for {} breaks: {:.1}x slower\n\
+         same members in the same order, fractions equal to 1e-9: {}\n\
+         peak memory {:.0} MB",
+        t.cells[0],
+        t.cells[1],
+        t.cells[2],
+        t.nodes,
+        t.members,
+        t.free_dofs,
+        t.symbolic_seconds,
+        t.factor_seconds,
+        t.solve_seconds,
+        t.breaks,
+        t.refactor_every,
+        t.refactorizations,
+        t.breaking_seconds,
+        per_break,
+        t.breaking_seconds / t.factor_seconds.max(1e-12),
+        t.refactor_seconds_per_break,
+        t.compared_breaks,
+        refactor_total,
+        t.breaks,
+        refactor_total / t.breaking_seconds.max(1e-12),
+        if t.same_sequence { "yes" } else { "NO" },
+        t.peak_memory as f64 / 1048576.0
+    )
+}

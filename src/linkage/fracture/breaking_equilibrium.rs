@@ -1,0 +1,573 @@
+//! The linear equilibrium of a body whose members break, event by event (sequentially linear
+//! analysis): within each load step the member that reaches its strength first as the load
+//! grows breaks, the solution is corrected, and so on until every intact member is within its
+//! strength at the step's load.
+//!
+//! `K_ff` is factored once; a break is the rank-one change `K_ff − k g gᵀ` (`g` the member's
+//! axis at its free DOFs), taken into the solves by the Woodbury identity
+//! ([`LowRankUpdate`]), and `K_ff` is refactored only after `refactor_every` breaks or when a
+//! piece falls off. A load pattern's solution `u` becomes `u + w e / s` after a break
+//! (Sherman–Morrison, with prescribed displacements too: `e` is the member's elongation,
+//! `w = K⁻¹ g`, `s = 1/k − gᵀ w`), so a break costs one solve with the factor, not a solve per
+//! pattern.
+
+use crate::linalg::{CholeskyError, LowRankUpdate, SparseCholesky};
+use crate::linkage::body_state::{linear_internal_forces, linear_stretch, undeformed_axis};
+use crate::linkage::fracture::{
+    critical_fraction, member_limits, unsupported_pieces, BreakEvent, FallenPiece, FractureState,
+};
+use crate::linkage::load_patterns::{solve_load_patterns, LoadPattern};
+use crate::linkage::mechanism::diagnose_mechanism;
+use crate::linkage::step_state::{force_scale, free_out_of_balance};
+use crate::linkage::{
+    axial_stiffness, member_block, post_process, Body, Convergence, DofMap, DofSlot, PhaseTimes,
+    SolveError, StepState, StiffnessAssembly,
+};
+use crate::Real;
+use nalgebra::Vector3;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Breaks between refactorizations of `K_ff` by default: the Woodbury correction of a solve
+/// costs `O(n r)` on top of the triangular solves, so `r` is kept well below the factor's fill.
+pub const DEFAULT_REFACTOR_EVERY: usize = 64;
+
+/// A break whose `1 − k gᵀ K⁻¹ g` is at most this leaves `K_ff` singular: a piece falls off
+/// or the structure collapses. Not far below 1: a part left on a hinge is singular only up to
+/// the rounding of the factor, and passing it on gives displacements of no meaning; a member
+/// whose removal makes the body a million times more flexible along its axis is taken to hold
+/// a mechanism.
+const SINGULAR_RATIO: Real = 1e-6;
+
+/// Per member its tensile and compressive strength (Pa, positive, infinite for none), or
+/// `None` when it does not break.
+pub type MemberLimits = Vec<Option<(Real, Real)>>;
+
+/// The linear equilibrium of a body with breaking members (see the module documentation).
+pub struct BreakingEquilibrium {
+    /// The free/support partition.
+    pub dofs: DofMap,
+    /// The pattern of `K_ff`.
+    pub assembly: StiffnessAssembly,
+    /// Time spent in each phase, s (refactorizations in `numeric`).
+    pub times: PhaseTimes,
+    /// Numeric factorizations of `K_ff` so far (the first included).
+    pub factorizations: usize,
+    /// Breaks between refactorizations.
+    pub refactor_every: usize,
+    values: Vec<Real>,
+    cholesky: Option<SparseCholesky>,
+    update: LowRankUpdate,
+    /// Per member `A E / L`, N/m; 0 once broken or fallen off.
+    stiffness: Vec<Real>,
+    axes: Vec<Vector3<Real>>,
+    /// Per member its undeformed length, m.
+    lengths: Vec<Real>,
+    /// Per member its tensile and compressive strength (Pa, infinite for none) when its
+    /// material breaks.
+    limits: MemberLimits,
+    patterns: Vec<LoadPattern>,
+    /// Members broken so far, in order.
+    broken: Vec<usize>,
+    /// Per node, whether it fell off with a piece.
+    fallen_node: Vec<bool>,
+    supported_node: Vec<bool>,
+}
+
+impl BreakingEquilibrium {
+    /// Validate, assemble, factor and solve every load pattern of the (linear) `body`, each
+    /// member's strength from its material (scattered when it has `scatter`).
+    pub fn new(body: &Body) -> Result<Self, SolveError> {
+        let limits = member_limits(body);
+        Self::with_limits(body, limits)
+    }
+
+    /// [`BreakingEquilibrium::new`] with each member's strengths given (tensile, compressive,
+    /// Pa; `None`: the member does not break), e.g. drawn with scatter.
+    pub fn with_limits(body: &Body, limits: MemberLimits) -> Result<Self, SolveError> {
+        body.validate()?;
+        let t = Instant::now();
+        let dofs = DofMap::new(body);
+        let assembly = StiffnessAssembly::new(body, &dofs)?;
+        let stiffness: Vec<Real> = (0..body.members.len())
+            .map(|m| {
+                axial_stiffness(
+                    &body.materials[body.members[m].material],
+                    body.member_length(m),
+                )
+            })
+            .collect();
+        let axes = body
+            .members
+            .iter()
+            .map(|m| undeformed_axis(body, m.nodes[0], m.nodes[1]))
+            .collect();
+        let lengths = (0..body.members.len())
+            .map(|m| body.member_length(m))
+            .collect();
+        let mut supported_node = vec![false; body.nodes.len()];
+        for &dof in &dofs.supported {
+            supported_node[dof / dofs.dofs_per_node] = true;
+        }
+        let n = assembly.n;
+        let mut eq = BreakingEquilibrium {
+            dofs,
+            assembly,
+            times: PhaseTimes::default(),
+            factorizations: 0,
+            refactor_every: DEFAULT_REFACTOR_EVERY,
+            values: Vec::new(),
+            cholesky: None,
+            update: LowRankUpdate::new(n, SINGULAR_RATIO),
+            stiffness,
+            axes,
+            lengths,
+            limits,
+            patterns: Vec::new(),
+            broken: Vec::new(),
+            fallen_node: vec![false; body.nodes.len()],
+            supported_node,
+        };
+        eq.fill(body);
+        eq.times.assembly = t.elapsed().as_secs_f64();
+        if n > 0 {
+            let t = Instant::now();
+            let a = &eq.assembly;
+            let c = SparseCholesky::analyze(a.n, &a.col_ptr, &a.row_idx, Some(&a.groups))
+                .map_err(|e| factorization_error(body, e))?;
+            eq.times.symbolic = t.elapsed().as_secs_f64();
+            eq.cholesky = Some(c);
+            if let Err(e) = eq.factorize() {
+                return Err(eq.singular(body, e));
+            }
+        }
+        let t = Instant::now();
+        let BreakingEquilibrium {
+            dofs,
+            stiffness,
+            cholesky,
+            update,
+            ..
+        } = &mut eq;
+        let patterns = solve_load_patterns(body, dofs, n, stiffness, &mut |rhs| {
+            if let Some(c) = cholesky.as_mut() {
+                update.solve(&mut |x| c.solve_in_place(x), rhs);
+            }
+            true
+        });
+        eq.patterns = patterns.unwrap_or_default();
+        eq.times.solve += t.elapsed().as_secs_f64();
+        Ok(eq)
+    }
+
+    /// Members broken so far, 0-based, in order.
+    pub fn broken(&self) -> &[usize] {
+        &self.broken
+    }
+
+    /// Fill `K_ff` with the intact members; a free DOF of a node left without members is held
+    /// by a diagonal entry (it carries no load and stays in place).
+    fn fill(&mut self, body: &Body) {
+        let stiffness = &self.stiffness;
+        self.assembly.fill(
+            body,
+            |m| {
+                let [a, b] = body.members[m].nodes;
+                member_block(&body.nodes[a], &body.nodes[b], stiffness[m])
+            },
+            &mut self.values,
+        );
+        let mut has_member = vec![false; body.nodes.len()];
+        for (m, member) in body.members.iter().enumerate() {
+            if self.stiffness[m] > 0.0 {
+                member.nodes.iter().for_each(|&n| has_member[n] = true);
+            }
+        }
+        // The hold is as stiff as the stiffest member, so the factor's pivot test does not
+        // take it for a singular pivot.
+        let hold = self.stiffness.iter().copied().fold(0.0, Real::max).max(1.0);
+        let d = self.dofs.dofs_per_node;
+        for (node, _) in has_member.iter().enumerate().filter(|(_, h)| !**h) {
+            for dir in 0..d {
+                if let Some(place) = self.assembly.diagonal_place(node, dir) {
+                    self.values[place] = hold;
+                }
+            }
+        }
+    }
+
+    fn factorize(&mut self) -> Result<(), CholeskyError> {
+        let t = Instant::now();
+        let result = match self.cholesky.as_mut() {
+            Some(c) => c.factorize(&self.values),
+            None => Ok(()),
+        };
+        self.times.numeric += t.elapsed().as_secs_f64();
+        self.factorizations += 1;
+        self.update.clear();
+        result
+    }
+
+    /// Turn a failed first factorization into a mechanism report naming nodes and directions.
+    fn singular(&mut self, body: &Body, e: CholeskyError) -> SolveError {
+        let pivot = match e {
+            CholeskyError::NonPositivePivot { dof } => dof,
+            CholeskyError::NearlySingular { dof, .. } => dof,
+            other => return factorization_error(body, other),
+        };
+        match self.cholesky.as_mut() {
+            Some(c) => SolveError::Mechanism(Box::new(diagnose_mechanism(
+                body,
+                &self.dofs,
+                &self.assembly,
+                &self.values,
+                c,
+                pivot,
+            ))),
+            None => factorization_error(body, e),
+        }
+    }
+
+    /// Refactor `K_ff` with the members broken so far and solve every pattern again (loads on
+    /// fallen nodes dropped). `false` when `K_ff` is singular: the supported part is a mechanism.
+    fn refactor(&mut self, body: &Body) -> bool {
+        let t = Instant::now();
+        self.fill(body);
+        self.times.assembly += t.elapsed().as_secs_f64();
+        if self.factorize().is_err() {
+            return false;
+        }
+        let t = Instant::now();
+        let d = self.dofs.dofs_per_node;
+        let n = self.assembly.n;
+        let mut internal = vec![0.0; body.dof_count()];
+        let mut rhs = vec![0.0; n];
+        for p in &mut self.patterns {
+            for (node, _) in self.fallen_node.iter().enumerate().filter(|(_, f)| **f) {
+                for k in 0..d {
+                    p.forces[node * d + k] = 0.0;
+                }
+            }
+            // F_f − K_fs U_s: the prescribed displacements alone.
+            for &dof in &self.dofs.free {
+                p.displacements[dof] = 0.0;
+            }
+            linear_internal_forces(body, &self.stiffness, &p.displacements, &mut internal);
+            for (i, &dof) in self.dofs.free.iter().enumerate() {
+                rhs[i] = p.forces[dof] - internal[dof];
+            }
+            if let Some(c) = self.cholesky.as_mut() {
+                c.solve_in_place(&mut rhs);
+            }
+            for (i, &dof) in self.dofs.free.iter().enumerate() {
+                p.displacements[dof] = rhs[i];
+            }
+        }
+        self.times.solve += t.elapsed().as_secs_f64();
+        true
+    }
+
+    /// Per pattern, the elongation of member `m`, m.
+    fn elongations(&self, body: &Body, m: usize) -> Vec<Real> {
+        let d = self.dofs.dofs_per_node;
+        self.patterns
+            .iter()
+            .map(|p| linear_stretch(&p.displacements, d, body.members[m].nodes, &self.axes[m]))
+            .collect()
+    }
+
+    /// Displacements per body DOF with each pattern at its factor.
+    fn combine(&self, factors: &[Real], field: impl Fn(&LoadPattern) -> &[Real]) -> Vec<Real> {
+        let nd = self.dofs.slots.len();
+        let mut u = vec![0.0; nd];
+        for (p, &f) in self.patterns.iter().zip(factors) {
+            if f == 0.0 {
+                continue;
+            }
+            for (ui, v) in u.iter_mut().zip(field(p)) {
+                *ui += f * v;
+            }
+        }
+        u
+    }
+
+    /// The next member to break between the loads at pattern factors `f0` (t = 0) and `f1`
+    /// (t = 1): the smallest critical fraction, ties by member number.
+    fn next_break(&self, body: &Body, f0: &[Real], f1: &[Real]) -> Option<BreakEvent> {
+        let d = self.dofs.dofs_per_node;
+        let u0 = self.combine(f0, |p| &p.displacements);
+        let u1 = self.combine(f1, |p| &p.displacements);
+        let start_unloaded = f0.iter().all(|&f| f == 0.0);
+        // Each member's critical fraction on its own (in parallel: no sums cross members),
+        // then the smallest found in member order, so the answer does not depend on threads.
+        let fractions: Vec<Option<Real>> = (0..body.members.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|m| {
+                let (tensile, compressive) = self.limits[m]?;
+                if self.stiffness[m] == 0.0 {
+                    return None;
+                }
+                let member = &body.members[m];
+                let material = &body.materials[member.material];
+                // The stress as the step's results report it (E A ε / A).
+                let stress = |u: &[Real]| {
+                    let strain =
+                        linear_stretch(u, d, member.nodes, &self.axes[m]) / self.lengths[m];
+                    material.youngs_modulus * strain * material.area / material.area
+                };
+                let end = stress(&u1);
+                if end <= tensile && end >= -compressive {
+                    return None;
+                }
+                let a = if start_unloaded { 0.0 } else { stress(&u0) };
+                critical_fraction(a, end - a, tensile, compressive)
+            })
+            .collect();
+        let mut best: Option<BreakEvent> = None;
+        for (m, t) in fractions.into_iter().enumerate() {
+            if let Some(t) = t {
+                if best.is_none_or(|b| t < b.fraction) {
+                    best = Some(BreakEvent {
+                        member: m,
+                        fraction: t,
+                    });
+                }
+            }
+        }
+        best
+    }
+
+    /// Break member `m`: correct every pattern's solution, or, when the break leaves `K_ff`
+    /// singular, remove the pieces it left unsupported (returned) and refactor. `Err(())` when
+    /// the supported part itself is a mechanism.
+    fn break_member(&mut self, body: &Body, m: usize) -> Result<Vec<FallenPiece>, ()> {
+        let d = self.dofs.dofs_per_node;
+        let k = self.stiffness[m];
+        let mut g = Vec::with_capacity(2 * d);
+        for (sign, &node) in [-1.0, 1.0].iter().zip(&body.members[m].nodes) {
+            for dir in 0..d {
+                if let DofSlot::Free(i) = self.dofs.slots[node * d + dir] {
+                    g.push((i, sign * self.axes[m][dir]));
+                }
+            }
+        }
+        let elongations = self.elongations(body, m);
+        self.broken.push(m);
+        let t = Instant::now();
+        let removal = match self.cholesky.as_mut() {
+            Some(c) if !g.is_empty() => self
+                .update
+                .remove(&mut |x| c.solve_in_place(x), &g, k)
+                .map(Some),
+            _ => Ok(None),
+        };
+        self.times.solve += t.elapsed().as_secs_f64();
+        self.stiffness[m] = 0.0;
+        match removal {
+            Ok(Some(r)) => {
+                for (p, e) in self.patterns.iter_mut().zip(&elongations) {
+                    let coef = e / r.s;
+                    for (i, &dof) in self.dofs.free.iter().enumerate() {
+                        p.displacements[dof] += coef * r.w[i];
+                    }
+                }
+                if self.update.rank() >= self.refactor_every && !self.refactor(body) {
+                    return Err(());
+                }
+                Ok(Vec::new())
+            }
+            Ok(None) => Ok(Vec::new()),
+            Err(_) => {
+                let pieces = self.release_pieces(body);
+                if pieces.is_empty() {
+                    return Err(());
+                }
+                if !self.refactor(body) {
+                    return Err(());
+                }
+                Ok(pieces
+                    .into_iter()
+                    .map(|nodes| FallenPiece { member: m, nodes })
+                    .collect())
+            }
+        }
+    }
+
+    /// After a break that left `K_ff` singular: remove what no longer holds on. A piece is a
+    /// connected part without supports; a node without supports on fewer intact members than
+    /// its dimension (a 2D node hanging on one member, a 3D node on two) turns freely about
+    /// them and goes with its members. Repeated until nothing more comes loose; the pieces
+    /// found (nodes ascending, by first node), empty when the singular mode is elsewhere.
+    fn release_pieces(&mut self, body: &Body) -> Vec<Vec<usize>> {
+        let members: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
+        let d = self.dofs.dofs_per_node;
+        let mut released = vec![false; body.nodes.len()];
+        loop {
+            let intact: Vec<bool> = self.stiffness.iter().map(|&s| s > 0.0).collect();
+            let mut count = vec![0usize; body.nodes.len()];
+            for (m, &[a, b]) in members.iter().enumerate() {
+                if intact[m] {
+                    count[a] += 1;
+                    count[b] += 1;
+                }
+            }
+            let mut loose: Vec<usize> = (0..body.nodes.len())
+                .filter(|&n| {
+                    !self.fallen_node[n] && !self.supported_node[n] && count[n] > 0 && count[n] < d
+                })
+                .collect();
+            let pieces = unsupported_pieces(
+                body.nodes.len(),
+                &members,
+                &intact,
+                &self.supported_node,
+                &self.fallen_node,
+            );
+            loose.extend(pieces.iter().flatten());
+            if loose.is_empty() {
+                break;
+            }
+            for &n in &loose {
+                self.fallen_node[n] = true;
+                released[n] = true;
+            }
+            for (j, member) in body.members.iter().enumerate() {
+                if member.nodes.iter().any(|&n| self.fallen_node[n]) {
+                    self.stiffness[j] = 0.0;
+                }
+            }
+        }
+        // The released nodes, grouped by the members they had before the break.
+        let intact_before: Vec<bool> = body
+            .members
+            .iter()
+            .map(|m| m.nodes.iter().all(|&n| released[n]))
+            .collect();
+        let not_released: Vec<bool> = released.iter().map(|r| !r).collect();
+        unsupported_pieces(
+            body.nodes.len(),
+            &members,
+            &intact_before,
+            &vec![false; body.nodes.len()],
+            &not_released,
+        )
+    }
+
+    /// Break the next member the load of `step` (of `steps`) breaks, if any, and return its
+    /// event; pieces that fall off are appended to `fallen`. [`SolveError::Collapse`] (its
+    /// `breaks` holding this event alone) when the break leaves the supported part a mechanism.
+    pub fn next_event(
+        &mut self,
+        body: &Body,
+        step: usize,
+        steps: usize,
+        fallen: &mut Vec<FallenPiece>,
+    ) -> Result<Option<BreakEvent>, SolveError> {
+        if step == 0 {
+            return Ok(None);
+        }
+        let factors = |s: usize| -> Vec<Real> {
+            self.patterns
+                .iter()
+                .map(|p| p.schedule.factor(s, steps))
+                .collect()
+        };
+        let (f0, f1) = (factors(step - 1), factors(step));
+        let Some(event) = self.next_break(body, &f0, &f1) else {
+            return Ok(None);
+        };
+        match self.break_member(body, event.member) {
+            Ok(pieces) => {
+                fallen.extend(pieces);
+                Ok(Some(event))
+            }
+            Err(()) => Err(SolveError::Collapse {
+                body: body.name.clone(),
+                step,
+                member: event.member,
+                breaks: vec![event],
+            }),
+        }
+    }
+
+    /// The state at `step` of `steps` after every break the step's load causes (step 0:
+    /// undeformed, unloaded). Steps are meant to come in order: the increment is from step
+    /// `step − 1`'s loads. [`SolveError::Collapse`] when a break leaves the supported part a
+    /// mechanism.
+    pub fn solve_step(
+        &mut self,
+        body: &Body,
+        step: usize,
+        steps: usize,
+    ) -> Result<StepState, SolveError> {
+        let mut fracture = FractureState::default();
+        loop {
+            match self.next_event(body, step, steps, &mut fracture.fallen) {
+                Ok(Some(event)) => fracture.breaks.push(event),
+                Ok(None) => break,
+                Err(SolveError::Collapse {
+                    body,
+                    step,
+                    member,
+                    breaks,
+                }) => {
+                    fracture.breaks.extend(breaks);
+                    return Err(SolveError::Collapse {
+                        body,
+                        step,
+                        member,
+                        breaks: fracture.breaks,
+                    });
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        fracture.broken = self.broken.clone();
+        let factors: Vec<Real> = self
+            .patterns
+            .iter()
+            .map(|p| p.schedule.factor(step, steps))
+            .collect();
+        let d = self.dofs.dofs_per_node;
+        let u = self.combine(&factors, |p| &p.displacements);
+        let forces = self.combine(&factors, |p| &p.forces);
+        let mut internal = vec![0.0; u.len()];
+        linear_internal_forces(body, &self.stiffness, &u, &mut internal);
+        let members = body.members.iter().enumerate().map(|(m, member)| {
+            let strain = linear_stretch(&u, d, member.nodes, &self.axes[m]) / body.member_length(m);
+            let material = &body.materials[member.material];
+            let force = if self.stiffness[m] > 0.0 {
+                material.youngs_modulus * strain * material.area
+            } else {
+                0.0
+            };
+            (strain, force)
+        });
+        let mut state = post_process(body, &self.dofs, &u, &forces, &internal, members);
+        state.iterations = usize::from(step > 0);
+        state.fracture = Some(fracture);
+        // Once a body has split, its parts may carry next to nothing (each moved rigidly by
+        // its supports): the residual is taken relative to the member forces the displacements
+        // could give as well, k_max |u|_max, so rounding in them is not read as an error.
+        let umax = u.iter().fold(0.0, |m: Real, v| m.max(v.abs()));
+        let kmax = self.stiffness.iter().copied().fold(0.0, Real::max);
+        let scale = force_scale(&self.dofs, &forces, &internal).max(kmax * umax);
+        state.residual =
+            Convergence::relative(free_out_of_balance(&self.dofs, &forces, &internal), scale);
+        if !state.residual.is_finite() || state.residual > 1e-6 {
+            return Err(SolveError::Inaccurate {
+                body: body.name.clone(),
+                residual: state.residual,
+            });
+        }
+        Ok(state)
+    }
+}
+
+fn factorization_error(body: &Body, e: CholeskyError) -> SolveError {
+    SolveError::Factorization {
+        body: body.name.clone(),
+        message: e.to_string(),
+    }
+}

@@ -1,0 +1,385 @@
+//! Members that break: closed forms for the load at each break (sequentially linear
+//! analysis, event by event), collapse as a result, pieces that fall off. Tolerances are
+//! stated where they are used.
+
+use linkage::linkage::fracture::BreakingEquilibrium;
+use linkage::linkage::{Body, Dimension, Failure, Material, Member, Schedule, Support};
+use linkage::scene::{load_scene, run, Summary};
+use nalgebra::Vector3;
+use std::path::Path;
+
+/// E A of every member, N, and the tensile strength times the area, N.
+const EA: f64 = 200e9 * 1e-4;
+const FT_A: f64 = 250e6 * 1e-4;
+
+/// Write `name.toml`, `name.nodes` and `name.links` into `dir` (materials `steel`, breaking
+/// at 250 MPa in tension, and `strong`, unbreakable; E = 200 GPa, A = 1 cm²) and run the
+/// scene into `dir/out`.
+fn run_scene(
+    dir: &Path,
+    name: &str,
+    steps: usize,
+    nodes: &str,
+    links: &str,
+    rest: &str,
+) -> Summary {
+    std::fs::write(dir.join(format!("{name}.nodes")), nodes).unwrap();
+    std::fs::write(dir.join(format!("{name}.links")), links).unwrap();
+    let scene = dir.join(format!("{name}.toml"));
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "{name}"
+steps = {steps}
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+tensile_strength = 250e6
+failure = "break"
+
+[[materials]]
+name = "strong"
+youngs_modulus = 200e9
+area = 1e-4
+
+[[bodies]]
+name = "truss"
+nodes = "{name}.nodes"
+links = "{name}.links"
+material = "steel"
+{rest}"#
+        ),
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    run(&world, &dir.join("out"), &|| {}).expect("the run ends with a result")
+}
+
+fn step_file(dir: &Path, name: &str, step: usize) -> Option<serde_json::Value> {
+    let text =
+        std::fs::read_to_string(dir.join(format!("out/{name}/steps/{step:04}.json"))).ok()?;
+    Some(serde_json::from_str(&text).unwrap())
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * b.abs()
+}
+
+/// A statically determinate triangle: node 1 pinned, node 2 on a roller, P down at the apex
+/// (node 3) over 3 steps to 80 kN. The diagonals carry P/√2 in compression, the bottom chord
+/// P/2 in tension (no compressive strength given): it breaks at P/2 = f_t A, P = 50 kN, load
+/// factor 50/80 = 0.625, in step 2; then the roller slides: the structure collapses. Steps 0
+/// and 1 are written; the run is a result, not an error.
+#[test]
+fn a_determinate_truss_breaks_at_the_hand_load_then_collapses() {
+    let dir = tempfile::tempdir().unwrap();
+    let summary = run_scene(
+        dir.path(),
+        "determinate",
+        3,
+        "0 0\n2 0\n1 1\n",
+        "1 2\n1 3\n2 3\n",
+        r#"[[bodies.supports]]
+nodes = [1]
+fix = ["x", "y"]
+[[bodies.supports]]
+nodes = [2]
+fix = ["y"]
+[[bodies.loads]]
+nodes = [3]
+force = [0.0, -80000.0]
+"#,
+    );
+    let expected = 2.0 * FT_A / 80000.0;
+    assert!((expected - 0.625).abs() < 1e-15);
+    let collapse = summary.collapse.as_ref().expect("a collapse");
+    assert_eq!((collapse.step, collapse.member), (2, 1));
+    assert_eq!(collapse.body, "truss");
+    // To 1e-9 relative: the load factor of a break is exact up to rounding.
+    assert!(close(collapse.load_factor, expected, 1e-9), "{collapse:?}");
+    assert_eq!(summary.breaks.len(), 1);
+    assert_eq!((summary.breaks[0].step, summary.breaks[0].member), (2, 1));
+    assert!(close(summary.breaks[0].load_factor, expected, 1e-9));
+    assert_eq!(summary.steps.len(), 2, "steps 0 and 1 solved");
+    assert!(summary.failure.is_none());
+    let step1 = step_file(dir.path(), "determinate", 1).expect("step 1 written");
+    let body = &step1["bodies"][0];
+    assert_eq!(body["broken"], serde_json::json!([]));
+    assert_eq!(body["breaks"], serde_json::json!([]));
+    // Below the strength at step 1 (P = 26.7 kN): the chord carries P/2.
+    assert!(close(
+        body["axial_forces"][0].as_f64().unwrap(),
+        80000.0 / 3.0 / 2.0,
+        1e-9
+    ));
+    assert!(step_file(dir.path(), "determinate", 2).is_none());
+    let text = std::fs::read_to_string(dir.path().join("out/determinate/summary.json")).unwrap();
+    assert!(text.contains("\"collapse\""));
+}
+
+/// The symmetric three-bar truss: node 1 held by a vertical bar (member 2, length 1) and two
+/// bars at 45° (members 1 and 3, length √2), P down at node 1 (one step to 50 kN). By
+/// compatibility the vertical bar carries P/(1 + 1/√2), each inclined one half as much: the
+/// vertical bar breaks first, at P₁ = f_t A (1 + 1/√2) = 42.68 kN. The two left must carry P
+/// alone, P/√2 each, beyond their strength from P₂ = √2 f_t A = 35.36 kN: a snap-back, below
+/// P₁. Member 1 breaks there (the tie goes to the lower number); node 1 then hangs on member
+/// 3 alone, comes loose and falls off with its load (reported, and the run goes on).
+#[test]
+fn an_indeterminate_truss_snaps_back_and_its_loose_node_falls_off() {
+    let dir = tempfile::tempdir().unwrap();
+    let summary = run_scene(
+        dir.path(),
+        "three_bar",
+        2,
+        "0 0\n-1 1\n0 1\n1 1\n",
+        "1 2\n1 3\n1 4\n",
+        r#"[[bodies.supports]]
+nodes = [2, 3, 4]
+fix = ["x", "y"]
+[[bodies.loads]]
+nodes = [1]
+force = [0.0, -100000.0]
+"#,
+    );
+    let p1 = FT_A * (1.0 + 1.0 / 2f64.sqrt());
+    let p2 = FT_A * 2f64.sqrt();
+    assert!(summary.collapse.is_none());
+    assert_eq!(summary.steps.len(), 3);
+    let breaks: Vec<(usize, usize)> = summary.breaks.iter().map(|b| (b.step, b.member)).collect();
+    // Step 1 reaches 50 kN: both breaks there.
+    assert_eq!(breaks, vec![(1, 2), (1, 1)]);
+    // To 1e-9 relative: the snap-back's load factors.
+    assert!(close(summary.breaks[0].load_factor, p1 / 100000.0, 1e-9));
+    assert!(close(summary.breaks[1].load_factor, p2 / 100000.0, 1e-9));
+    assert!(summary.breaks[1].load_factor < summary.breaks[0].load_factor);
+    let step1 = step_file(dir.path(), "three_bar", 1).unwrap();
+    let body = &step1["bodies"][0];
+    assert_eq!(body["broken"], serde_json::json!([2, 1]));
+    assert_eq!(body["breaks"][1]["member"], 1);
+    assert_eq!(body["fallen"], serde_json::json!([1]));
+    assert!(summary.steps[1]
+        .warnings
+        .iter()
+        .any(|w| w.contains("fell off")));
+    // Nothing is loaded any more: every member force is zero, and so the reactions.
+    for f in body["axial_forces"].as_array().unwrap() {
+        assert_eq!(f.as_f64().unwrap(), 0.0);
+    }
+    let step2 = step_file(dir.path(), "three_bar", 2).unwrap();
+    assert_eq!(step2["bodies"][0]["breaks"], serde_json::json!([]));
+}
+
+/// A piece breaking off a structure that goes on carrying load: a stable triangle of strong
+/// members (nodes 1, 2 pinned, apex 3 loaded 10 kN sideways), and node 4 hung below nodes 1
+/// and 2 by two breaking members at 45° (members 4 and 5), pulled down by P up to 50 kN over
+/// 4 steps. Each hanger carries P/√2: they reach f_t A at P = √2 f_t A = 35.36 kN, load factor
+/// 0.7071, in step 3; member 4 breaks (tie to the lower number), node 4 comes loose and
+/// falls off; step 4 is solved with the triangle alone, which carries its own load as before.
+#[test]
+fn a_piece_that_breaks_off_is_reported_and_the_run_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let summary = run_scene(
+        dir.path(),
+        "pendant",
+        4,
+        "0 0\n2 0\n1 1\n1 -1\n",
+        "1 2 strong\n1 3 strong\n2 3 strong\n1 4\n2 4\n",
+        r#"[[bodies.supports]]
+nodes = [1, 2]
+fix = ["x", "y"]
+[[bodies.loads]]
+nodes = [3]
+force = [10000.0, 0.0]
+[[bodies.loads]]
+nodes = [4]
+force = [0.0, -50000.0]
+"#,
+    );
+    assert!(summary.collapse.is_none());
+    assert_eq!(summary.steps.len(), 5);
+    assert_eq!(summary.breaks.len(), 1);
+    assert_eq!((summary.breaks[0].step, summary.breaks[0].member), (3, 4));
+    assert!(close(
+        summary.breaks[0].load_factor,
+        FT_A * 2f64.sqrt() / 50000.0,
+        1e-9
+    ));
+    let step3 = step_file(dir.path(), "pendant", 3).unwrap();
+    assert_eq!(step3["bodies"][0]["fallen"], serde_json::json!([4]));
+    let step4 = step_file(dir.path(), "pendant", 4).unwrap();
+    let body = &step4["bodies"][0];
+    assert_eq!(body["broken"], serde_json::json!([4]));
+    assert!(body.get("fallen").is_none());
+    // The triangle alone: 10 kN sideways at the apex; the reactions answer it exactly.
+    let mut sum = [0.0f64; 2];
+    for r in body["reactions"].as_array().unwrap() {
+        for k in 0..2 {
+            sum[k] += r["force"][k].as_f64().unwrap();
+        }
+    }
+    assert!(
+        (sum[0] + 10000.0).abs() < 1e-6 && sum[1].abs() < 1e-6,
+        "{sum:?}"
+    );
+    assert_eq!(body["axial_forces"][3].as_f64().unwrap(), 0.0);
+    assert_eq!(body["axial_forces"][4].as_f64().unwrap(), 0.0);
+}
+
+/// A bundle of ten parallel members (length 1 m, E A = 2e7 N) of graded tensile strengths
+/// f_i = 105 + 10 i MPa (i = 0..9), pulled by a prescribed displacement growing to 1 mm over
+/// 20 steps: the stress at step s is 10 s MPa, so member i breaks halfway through step 11 + i
+/// (fraction 0.5 exactly) and the total force at step s is (members with f_i ≥ 10 s MPa)
+/// × E A × δ_s, δ_s = s × 0.05 mm.
+#[test]
+fn a_graded_bundle_follows_the_closed_form_force_curve() {
+    let mut body = Body::new("bundle", Dimension::Two);
+    let count = 10;
+    for i in 0..count {
+        body.nodes.push(Vector3::new(i as f64, 0.0, 0.0));
+        body.nodes.push(Vector3::new(i as f64, 1.0, 0.0));
+        let mut m = Material::new(&format!("m{i}"), 200e9, 1e-4);
+        m.tensile_strength = Some((105.0 + 10.0 * i as f64) * 1e6);
+        m.failure = Failure::Break;
+        body.materials.push(m);
+        body.members.push(Member {
+            nodes: [2 * i, 2 * i + 1],
+            material: i,
+        });
+        body.supports
+            .push(Support::fixed(2 * i, [true, true, false]));
+        body.supports.push(Support {
+            node: 2 * i + 1,
+            fixed: [true, true, false],
+            displacement: Vector3::new(0.0, 1e-3, 0.0),
+            schedule: Schedule::Linear,
+        });
+    }
+    let steps = 20;
+    let mut eq = BreakingEquilibrium::new(&body).unwrap();
+    for s in 1..=steps {
+        let state = eq.solve_step(&body, s, steps).unwrap();
+        let delta = s as f64 * 0.05e-3;
+        let intact = (0..count)
+            .filter(|&i| 105.0 + 10.0 * i as f64 >= 10.0 * s as f64)
+            .count();
+        let total: f64 = state
+            .reactions
+            .iter()
+            .filter(|(n, _)| n % 2 == 1)
+            .map(|(_, r)| r.y)
+            .sum();
+        // To 1e-9 of the largest force of the bundle.
+        let expected = intact as f64 * EA * delta;
+        assert!(
+            (total - expected).abs() <= 1e-9 * count as f64 * EA * 1e-3,
+            "step {s}: {total} N against {expected} N"
+        );
+        let fracture = state.fracture.unwrap();
+        if (11..11 + count).contains(&s) {
+            assert_eq!(fracture.breaks.len(), 1, "step {s}");
+            assert_eq!(fracture.breaks[0].member, s - 11);
+            assert!((fracture.breaks[0].fraction - 0.5).abs() < 1e-9);
+        } else {
+            assert!(fracture.breaks.is_empty(), "step {s}");
+        }
+    }
+}
+
+/// Breaking members need a linear body: a large-displacement body is refused, naming it.
+#[test]
+fn a_large_displacement_body_with_breaking_members_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("t.nodes"), "0 0\n2 0\n1 1\n").unwrap();
+    std::fs::write(dir.path().join("t.links"), "1 2\n1 3\n2 3\n").unwrap();
+    let scene = dir.path().join("t.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "t"
+[[materials]]
+name = "glass"
+youngs_modulus = 70e9
+area = 1e-4
+strength = 50e6
+failure = "break"
+[[bodies]]
+name = "pane"
+nodes = "t.nodes"
+links = "t.links"
+material = "glass"
+kinematics = "large"
+[[bodies.supports]]
+nodes = [1, 2]
+fix = ["x", "y"]
+[[bodies.loads]]
+nodes = [3]
+force = [0.0, -1.0]
+"#,
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    let err = run(&world, &dir.path().join("out"), &|| {})
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("'pane'") && err.contains("linear"), "{err}");
+    // failure = "break" without a strength is an error naming the material.
+    let text = std::fs::read_to_string(&scene)
+        .unwrap()
+        .replace("strength = 50e6\n", "");
+    std::fs::write(&scene, text).unwrap();
+    let err = load_scene(&scene).unwrap_err().to_string();
+    assert!(err.contains("glass") && err.contains("strength"), "{err}");
+}
+
+/// Scattered strengths (Weibull modulus 6, seed 7) on a 2D lattice pulled by a prescribed
+/// displacement: one thread and two give byte-identical step files and the same breaks.
+#[test]
+fn the_same_seed_gives_byte_identical_results_on_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scatter.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "scatter"
+steps = 4
+[[materials]]
+name = "rock"
+youngs_modulus = 30e9
+area = 1e-4
+tensile_strength = 3e6
+failure = "break"
+scatter = { weibull_modulus = 6.0, seed = 7 }
+[[bodies]]
+name = "slab"
+rectangle = { width = 2.0, height = 1.0, cells = [16, 8] }
+material = "rock"
+[[bodies.supports]]
+on_line = { point = [0.0, 0.0], direction = [0.0, 1.0] }
+fix = ["x", "y"]
+[[bodies.supports]]
+on_line = { point = [2.0, 0.0], direction = [0.0, 1.0] }
+fix = ["x", "y"]
+displacement = [0.0002, 0.0]
+"#,
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    let run_on = |threads: usize| {
+        let out = dir.path().join(format!("out{threads}"));
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let summary = pool.install(|| run(&world, &out, &|| {}).unwrap());
+        let mut files = Vec::new();
+        for step in 0..summary.steps.len() {
+            files.push(std::fs::read(out.join(format!("scatter/steps/{step:04}.json"))).unwrap());
+        }
+        (summary.breaks, summary.collapse, files)
+    };
+    let one = run_on(1);
+    let two = run_on(2);
+    assert!(!one.0.is_empty(), "members break");
+    assert_eq!(one.0, two.0);
+    assert_eq!(one.1, two.1);
+    assert_eq!(one.2, two.2);
+}
