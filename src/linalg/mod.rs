@@ -6,6 +6,7 @@ pub use self::block_jacobi::{BlockJacobi, SingularBlock};
 pub use self::cholesky::{CholeskyError, SparseCholesky};
 pub use self::conjugate_gradient::{conjugate_gradient, CgReport, CgSettings, Preconditioner};
 pub use self::ldlt::SparseLdlt;
+pub use self::low_rank::{LowRankCorrection, SparseColumn};
 pub use self::multigrid::{MultigridError, SmoothedAggregation};
 pub use self::symmetric_csr::{dot, SymmetricCsr};
 
@@ -14,6 +15,7 @@ pub(crate) mod block_matrix;
 pub mod cholesky;
 mod conjugate_gradient;
 pub mod ldlt;
+mod low_rank;
 pub mod multigrid;
 pub mod ordering;
 mod symmetric_csr;

@@ -27,6 +27,7 @@ pub mod atomic_file;
 mod bounds;
 mod build;
 mod check;
+mod contact_pairs;
 mod driver;
 mod instability;
 mod link_lines;
