@@ -446,3 +446,61 @@ friction = 0.5
         "c/a {ratio} against {closed}"
     );
 }
+
+#[test]
+fn a_block_on_a_slope_holds_while_tan_theta_is_below_mu_and_slides_above() {
+    // The bundled block_on_slope.toml with its weight tilted by θ: held at 20° and 26°
+    // (tan 0.488 < μ = 0.5), reported sliding at 30° (tan 0.577 > μ) at step 1, the first
+    // with the weight (half of it: the weight ramps over two steps).
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/block_on_slope.toml"),
+    )
+    .unwrap();
+    for (degrees, holds) in [(20.0f64, true), (26.0, true), (30.0, false)] {
+        let t = degrees.to_radians();
+        let scene = text.replace(
+            "total_force = [342.020143325669, -939.692620785908, 0.0]",
+            &format!(
+                "total_force = [{:?}, {:?}, 0.0]",
+                1e3 * t.sin(),
+                -1e3 * t.cos()
+            ),
+        );
+        assert_ne!(scene, text);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("slope.toml");
+        std::fs::write(&path, scene).unwrap();
+        match run(&path) {
+            Ok(steps) => {
+                assert!(holds, "{degrees}°: held");
+                let b = &steps.last().unwrap().0.bodies[0];
+                let along: f64 = b.contacts.iter().map(|c| c.tangential_force[0]).sum();
+                assert!(
+                    (along + 1e3 * t.sin()).abs() < 1e-9 * 1e3,
+                    "{degrees}°: {along}"
+                );
+                assert!(b.contacts.iter().any(|c| c.state == "stick"));
+            }
+            Err(e) => {
+                assert!(!holds, "{degrees}°: {e}");
+                let RunError::Contact {
+                    source:
+                        ContactError::Sliding {
+                            step,
+                            body,
+                            load,
+                            capacity,
+                        },
+                    ..
+                } = &e
+                else {
+                    panic!("{degrees}°: {e}");
+                };
+                assert_eq!((*step, body.as_str()), (1, "block"));
+                // Half the weight at step 1 of 2.
+                assert!((load - 0.5e3 * t.sin()).abs() < 1e-6, "{e}");
+                assert!((capacity - 0.5 * 0.5e3 * t.cos()).abs() < 1e-6, "{e}");
+            }
+        }
+    }
+}

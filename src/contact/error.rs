@@ -96,8 +96,8 @@ pub enum ContactError {
         body: String,
         /// The tangential part of the body's applied loads at the step, N.
         load: Real,
-        /// The largest tangential force its contacts can hold, `Σ μ f_N` at the last solved
-        /// state, N.
+        /// The largest tangential force its contacts can hold, N: μ times the part of its
+        /// loads pressing it on them.
         capacity: Real,
     },
     /// The result is not finite.

@@ -105,9 +105,11 @@ impl ContactSolver {
                 }
                 Err(e) if self.friction.is_some() && gives_up(&e, &size, max_cuts) => {
                     // With friction, a body that will not settle may be one pushed along its
-                    // contacts beyond μ N: say so by name.
+                    // contacts beyond μ N: say so by name (judged where the attempt ended,
+                    // which has found the contacts the loads press it on).
+                    let sliding = self.sliding(bodies, obstacles, step, steps);
                     self.restore(saved);
-                    if let Some(sliding) = self.sliding(bodies, obstacles, step, steps) {
+                    if let Some(sliding) = sliding {
                         return Err(sliding);
                     }
                     if !retried(&e) {
@@ -137,7 +139,7 @@ impl ContactSolver {
         Ok(reported)
     }
 
-    /// The sliding of a body at `step` of `steps`, from the last converged state: a body whose
+    /// The sliding of a body at `step` of `steps`, from the current state: a body whose
     /// applied loads at the step have a part along its contacts (perpendicular to the sum of
     /// their normal forces) beyond the `Σ μ f_N` they hold there. `None` when no body is.
     fn sliding(
@@ -147,15 +149,18 @@ impl ContactSolver {
         step: usize,
         steps: usize,
     ) -> Option<ContactError> {
-        let history = self.friction.as_ref()?;
+        self.friction.as_ref()?;
         let t = step as Real;
         let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
+        // The contacts where the attempt ended (the set it solved last is not kept).
+        let found = self.look(bodies, &self.active.clone(), &offsets);
+        let history = self.friction.as_ref()?;
         let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
         let (tolerance, max_iterations) = newton_limits(bodies);
         let problem = Problem {
             bodies,
             geometry: &self.geometry,
-            set: &self.active,
+            set: &found,
             forces: &forces,
             offsets: &offsets,
             step,
@@ -167,20 +172,21 @@ impl ContactSolver {
         };
         let mut normals = self.normals.clone();
         let evaluated = problem.evaluate(&mut normals, &self.parts);
+        // Per body: the mean direction its contacts press it along, and the largest μ among
+        // them. Where the attempt ended the depths (and so the normal forces) are those of a
+        // state out of balance; the load's own normal part is what the contacts must carry.
         let mut normal = vec![Vector3::<Real>::zeros(); bodies.len()];
-        let mut capacity = vec![0.0; bodies.len()];
+        let mut mu = vec![0.0; bodies.len()];
         for e in &evaluated.list {
             let Some(n) = e.normal else { continue };
             let (key, _) = friction_key(&e.contact);
-            let (mu, _) = history.law(&key);
-            let f = e.normal_force().max(0.0);
-            // The pressing side gets +f n; a surface body its share of −f n.
+            let (m, _) = history.law(&key);
             for &(b, _, w) in &e.nodes {
-                normal[b] += n * (f * w);
-                capacity[b] += mu * f * w.abs();
+                normal[b] += n * w;
+                mu[b] = Real::max(mu[b], m);
             }
         }
-        let mut worst: Option<(usize, Real)> = None;
+        let mut worst: Option<(usize, Real, Real)> = None;
         for (b, body) in bodies.iter().enumerate() {
             let d = self.parts[b].dofs.dofs_per_node;
             let mut load = Vector3::zeros();
@@ -191,24 +197,19 @@ impl ContactSolver {
                 continue;
             };
             let along = (load - n * load.dot(&n)).norm();
-            if along > capacity[b] * (1.0 + 1e-9)
-                && worst.is_none_or(|(_, w)| along - capacity[b] > w)
+            let capacity = mu[b] * load.dot(&n).abs();
+            if along > capacity * (1.0 + 1e-9)
+                && worst.is_none_or(|(_, a, c)| along - capacity > a - c)
             {
-                worst = Some((b, along - capacity[b]));
+                worst = Some((b, along, capacity));
             }
         }
-        let (b, _) = worst?;
-        let d = self.parts[b].dofs.dofs_per_node;
-        let n = normal[b].normalize();
-        let mut load = Vector3::zeros();
-        for node in 0..bodies[b].nodes.len() {
-            load += crate::linkage::body_state::node_vector(&forces[b], d, node);
-        }
+        let (b, load, capacity) = worst?;
         Some(ContactError::Sliding {
             step,
             body: bodies[b].name.clone(),
-            load: (load - n * load.dot(&n)).norm(),
-            capacity: capacity[b],
+            load,
+            capacity,
         })
     }
 

@@ -363,7 +363,7 @@ impl ContactSolver {
     }
 
     /// The contacts of `found` after keeping patches against `solved`, timed as a query.
-    fn look(
+    pub(crate) fn look(
         &mut self,
         bodies: &[Body],
         solved: &ContactSet,
