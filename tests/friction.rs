@@ -61,6 +61,7 @@ normal = [0.0, 1.0]
 }
 
 /// Every step of the scene at `path`, with its summary.
+#[allow(clippy::result_large_err)]
 fn run(path: &Path) -> Result<Vec<(StepResult, StepSummary)>, RunError> {
     let world = load_scene(path).unwrap();
     let mut sim = Simulation::new(&world).expect("builds");
