@@ -396,6 +396,7 @@ fn contact_forces_are_drawn_as_orange_arrows_when_present() {
         with: "floor".into(),
         depth: 1e-4,
         force: vec![0.0, 300.0],
+        ..Default::default()
     });
     let ext = extent(&model, &step, Some(1.0));
     let with = count_orange(&draw_frame(&model, &step, &ext, &options()).unwrap());

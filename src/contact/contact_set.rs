@@ -1,5 +1,6 @@
 //! The set of active contacts the settle loop iterates on, and the contacts reported per node.
 
+use crate::contact::SlipState;
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -101,6 +102,16 @@ pub struct NodeContact {
     pub with: String,
     /// Penetration depth, m (≥ 0).
     pub depth: Real,
-    /// Force the node receives, N.
+    /// Force the node receives, N: `normal_force · normal + tangential_force`.
     pub force: Vector3<Real>,
+    /// Unit normal of the contact, from the surface towards the node.
+    pub normal: Vector3<Real>,
+    /// Normal force the node receives, N (≥ 0 pressing).
+    pub normal_force: Real,
+    /// Tangential (friction) force the node receives, N.
+    pub tangential_force: Vector3<Real>,
+    /// Whether the contact sticks or slips (frictionless contacts slip).
+    pub state: SlipState,
+    /// Slip of the node over what it touches, accumulated since the contact began, m.
+    pub slip: Vector3<Real>,
 }

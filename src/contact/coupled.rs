@@ -5,7 +5,7 @@ use crate::contact::coupled_system::CoupledSystem;
 use crate::contact::evaluate::{Evaluated, Evaluation};
 use crate::contact::settle::{largest_nodal_move, BodyPart, Problem, STABILISATION};
 use crate::contact::{ActiveContact, ContactError, ContactSet};
-use crate::linalg::CholeskyError;
+use crate::linalg::{CholeskyError, LowRankCorrection, SparseColumn};
 use crate::linkage::body_state::{fill_tangent, internal_force_vector, norm};
 use crate::linkage::line_search::backtrack;
 use crate::linkage::{Convergence, PhaseTimes, SolverUsed, StiffnessAssembly};
@@ -29,6 +29,11 @@ pub(crate) struct CoupledSolver {
     pub(crate) negative_pivots: usize,
     /// Conjugate gradients, when a body is solved iteratively.
     iterative: Option<CoupledIterative>,
+    /// The unsymmetric part of slipping contacts' tangents, `Σ u vᵀ` over global free DOFs,
+    /// as filled with the tangent (solved by [`LowRankCorrection`] on the symmetric factor).
+    rank_one: Vec<(SparseColumn, SparseColumn)>,
+    /// The Woodbury correction of the current factorization for `rank_one`.
+    correction: Option<LowRankCorrection>,
 }
 
 impl CoupledSolver {
@@ -57,6 +62,8 @@ impl CoupledSolver {
             unheld: 0,
             negative_pivots: 0,
             iterative,
+            rank_one: Vec::new(),
+            correction: None,
         })
     }
 
@@ -160,7 +167,7 @@ impl CoupledSolver {
             let (stabilised, delta) = if reuse {
                 let t = Instant::now();
                 let mut delta = r;
-                self.system.solve_in_place(&mut delta);
+                self.solve_factored(&mut delta);
                 times.solve += t.elapsed().as_secs_f64();
                 (false, delta)
             } else {
@@ -181,8 +188,9 @@ impl CoupledSolver {
                         let stabilised = self.factorize_filled(p, times)?;
                         self.factored = (!stabilised).then(|| p.set.clone());
                         let t = Instant::now();
+                        self.correct_for_rank_one();
                         let mut delta = r;
-                        self.system.solve_in_place(&mut delta);
+                        self.solve_factored(&mut delta);
                         times.solve += t.elapsed().as_secs_f64();
                         (stabilised, delta)
                     }
@@ -242,9 +250,24 @@ impl CoupledSolver {
         for (part, local) in parts.iter_mut().zip(locals) {
             part.local = local;
         }
+        self.rank_one.clear();
         for e in evaluated {
-            let Some(n) = e.normal else { continue };
-            let k = e.penalty.stiffness(&n);
+            let Some(k) = e.stiffness() else { continue };
+            if let Some((a, b)) = e.rank_one() {
+                let column = |v: &Vector3<Real>| {
+                    let mut col = SparseColumn::new();
+                    for &(body, node, w) in &e.nodes {
+                        let part = &parts[body];
+                        for q in 0..part.dofs.dofs_per_node {
+                            if let Some(i) = part.dofs.free_index(node, q) {
+                                col.push((self.system.offsets[body] + i, w * v[q]));
+                            }
+                        }
+                    }
+                    col
+                };
+                self.rank_one.push((column(&a), column(&b)));
+            }
             for &(b1, node1, w1) in &e.nodes {
                 for &(b2, node2, w2) in &e.nodes {
                     let (p1, p2) = (&parts[b1], &parts[b2]);
@@ -265,6 +288,23 @@ impl CoupledSolver {
         }
         times.assembly += t.elapsed().as_secs_f64();
         Ok(())
+    }
+
+    /// Form the Woodbury correction of the factored symmetric tangent for the unsymmetric
+    /// part of slipping contacts (none when nothing slips).
+    fn correct_for_rank_one(&mut self) {
+        let pairs = std::mem::take(&mut self.rank_one);
+        let system = &mut self.system;
+        self.correction =
+            LowRankCorrection::new(system.n, pairs, |b: &mut [Real]| system.solve_in_place(b));
+    }
+
+    /// Solve with the factored tangent, its unsymmetric slip part included.
+    fn solve_factored(&mut self, rhs: &mut [Real]) {
+        self.system.solve_in_place(rhs);
+        if let Some(c) = &self.correction {
+            c.correct(rhs);
+        }
     }
 
     /// Factor the filled tangent. When it is singular (a body not held by its supports and the

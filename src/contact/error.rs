@@ -87,6 +87,19 @@ pub enum ContactError {
     /// A node lies inside an obstacle or another body at step 0, deeper than the tolerance.
     #[error(transparent)]
     StartsInside(Box<crate::contact::StartOverlap>),
+    /// A body pushed along its contacts by more than friction can hold: no static equilibrium.
+    #[error("step {step}: body '{body}' slides: its loads push it along its contacts with {load:.6e} N, more than the {capacity:.6e} N (μ times the normal force) friction can hold, so it has no static equilibrium. Lower the tangential load, raise [contact] friction, or hold the body with a support")]
+    Sliding {
+        /// The step.
+        step: usize,
+        /// Body name.
+        body: String,
+        /// The tangential part of the body's applied loads at the step, N.
+        load: Real,
+        /// The largest tangential force its contacts can hold, N: μ times the part of its
+        /// loads pressing it on them.
+        capacity: Real,
+    },
     /// The result is not finite.
     #[error("step {step}: the solution with contact is not finite: check the penalty ([contact] penalty) and the loads")]
     NotFinite {

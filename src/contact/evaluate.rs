@@ -4,10 +4,14 @@ use crate::contact::boundary::segment_projection;
 use crate::contact::detect::Geometry;
 use crate::contact::patch_surface::triangle_projection;
 use crate::contact::settle::{position, BodyPart};
-use crate::contact::{ActiveContact, ContactSet, Penalty, Target};
+use crate::contact::{
+    return_mapping, ActiveContact, ContactSet, FrictionHistory, FrictionKey, Penalty, Tangential,
+    Target,
+};
+use crate::linkage::body_state::node_vector;
 use crate::linkage::Body;
 use crate::Real;
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use std::collections::HashMap;
 
 /// A contact evaluated at the current displacements.
@@ -23,6 +27,127 @@ pub(crate) struct Evaluated {
     /// The nodes the force acts on, as (body, node, weight): the pressing node with 1, a
     /// surface's nodes with minus their barycentric weights (momentum is conserved).
     pub(crate) nodes: Vec<(usize, usize, Real)>,
+    /// Friction (`None`: a frictionless pair): the tangential force on the pressing side, its
+    /// state, tangent and slip this increment.
+    pub(crate) tangential: Option<Tangential>,
+}
+
+impl Evaluated {
+    /// The normal force on the pressing side, N (negative: a pull, see [`Penalty::force`]).
+    pub(crate) fn normal_force(&self) -> Real {
+        self.penalty.stiffness * self.depth
+    }
+
+    /// The force on the pressing side, N: normal and tangential (zero without a normal).
+    pub(crate) fn force(&self) -> Vector3<Real> {
+        let Some(n) = self.normal else {
+            return Vector3::zeros();
+        };
+        let normal = self.penalty.force(self.depth, &n);
+        match &self.tangential {
+            Some(t) => normal + t.force,
+            None => normal,
+        }
+    }
+
+    /// The symmetric part of the contact's stiffness against the relative motion of the
+    /// pressing side, `−∂f/∂g`, N/m: the penalty's `k n nᵀ` plus that of friction.
+    pub(crate) fn stiffness(&self) -> Option<Matrix3<Real>> {
+        let n = self.normal?;
+        let k = self.penalty.stiffness(&n);
+        Some(match &self.tangential {
+            Some(t) => k + t.stiffness,
+            None => k,
+        })
+    }
+
+    /// The unsymmetric part of slip, `a bᵀ`, as `(a, b)` (see [`Tangential::rank_one`]).
+    pub(crate) fn rank_one(&self) -> Option<(Vector3<Real>, Vector3<Real>)> {
+        self.tangential.as_ref().and_then(|t| t.rank_one)
+    }
+}
+
+/// The friction history key of contact `c`, and the sign its obstacle's offset enters the
+/// relative motion of the pressing side with (−1: the obstacle is the surface; +1: the
+/// obstacle's sharp point presses; 0: between bodies).
+pub(crate) fn friction_key(c: &ActiveContact) -> (FrictionKey, Option<(usize, Real)>) {
+    match c.with {
+        Target::Obstacle(o) => (
+            FrictionKey::Obstacle {
+                body: c.body,
+                node: c.node,
+                obstacle: o,
+            },
+            Some((o, -1.0)),
+        ),
+        Target::Sharp { obstacle, .. } => (
+            FrictionKey::Sharp {
+                body: c.body,
+                point: c.node,
+                obstacle,
+            },
+            Some((obstacle, 1.0)),
+        ),
+        Target::Patch { body, .. } | Target::Segment { body, .. } | Target::Vertex { body, .. } => {
+            (
+                FrictionKey::Body {
+                    body: c.body,
+                    node: c.node,
+                    other: body,
+                },
+                None,
+            )
+        }
+    }
+}
+
+/// The tangential answer of contact `c` (with `nodes` and weights, normal `n`, depth (m) and
+/// penalty) against the history: `None` for a frictionless pair.
+#[allow(clippy::too_many_arguments)]
+fn friction_of(
+    history: &FrictionHistory,
+    parts: &[BodyPart],
+    c: &ActiveContact,
+    nodes: &[(usize, usize, Real)],
+    n: &Vector3<Real>,
+    depth: Real,
+    penalty: Penalty,
+    offsets: &[Vector3<Real>],
+) -> Option<Tangential> {
+    let (key, obstacle) = friction_key(c);
+    let (mu, kt) = history.law(&key);
+    if mu <= 0.0 {
+        return None;
+    }
+    let mut dg = Vector3::zeros();
+    for &(b, node, w) in nodes {
+        let d = parts[b].dofs.dofs_per_node;
+        let now = node_vector(&parts[b].u, d, node);
+        let then = history
+            .u
+            .get(b)
+            .map_or(Vector3::zeros(), |u| node_vector(u, d, node));
+        dg += (now - then) * w;
+    }
+    if let Some((o, sign)) = obstacle {
+        let then = history.offsets.get(o).copied().unwrap_or_default();
+        dg += (offsets[o] - then) * sign;
+    }
+    let old = history
+        .committed
+        .get(&key)
+        .map_or(Vector3::zeros(), |s| s.force);
+    let kn = penalty.stiffness;
+    let kt = kt.unwrap_or(kn);
+    Some(return_mapping(
+        mu,
+        kt,
+        kn,
+        kn * depth.max(0.0),
+        n,
+        &old,
+        &dg,
+    ))
 }
 
 /// Every contact of a set evaluated at one iterate, and the contact force they make.
@@ -43,8 +168,10 @@ struct Touch {
 }
 
 /// Evaluate every contact of `set` at the bodies' current displacements, with the obstacles at
-/// `offsets` (m). A contact whose normal cannot be found (a node exactly on the surface) takes
-/// the last one seen in `normals`; every normal found is remembered there.
+/// `offsets` (m), and their friction against `friction` (`None`: frictionless). A contact whose
+/// normal cannot be found (a node exactly on the surface) takes the last one seen in
+/// `normals`; every normal found is remembered there.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn evaluate(
     geometry: &Geometry,
     normals: &mut HashMap<ActiveContact, Vector3<Real>>,
@@ -52,6 +179,7 @@ pub(crate) fn evaluate(
     parts: &[BodyPart],
     set: &ContactSet,
     offsets: &[Vector3<Real>],
+    friction: Option<&FrictionHistory>,
 ) -> Evaluation {
     let mut f: Vec<Vec<Real>> = parts.iter().map(|p| vec![0.0; p.u.len()]).collect();
     let mut list = Vec::with_capacity(set.len());
@@ -96,8 +224,14 @@ pub(crate) fn evaluate(
             }
             None => normals.get(c).copied(),
         };
+        let mut tangential = None;
         if let Some(n) = normal {
-            let force = penalty.force(depth, &n);
+            let mut force = penalty.force(depth, &n);
+            tangential = friction
+                .and_then(|h| friction_of(h, parts, c, &nodes, &n, depth, penalty, offsets));
+            if let Some(t) = &tangential {
+                force += t.force;
+            }
             for &(b, node, w) in &nodes {
                 let d = parts[b].dofs.dofs_per_node;
                 for k in 0..d {
@@ -111,6 +245,7 @@ pub(crate) fn evaluate(
             normal,
             penalty,
             nodes,
+            tangential,
         });
     }
     Evaluation { forces: f, list }

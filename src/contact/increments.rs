@@ -8,9 +8,10 @@
 //! the increment is halved ([`IncrementSize`], as for a body). Only the converged end of the
 //! step is reported.
 
+use crate::contact::evaluate::friction_key;
 use crate::contact::report::ContactStep;
 use crate::contact::settle::{newton_limits, Problem, PATH_POINTS};
-use crate::contact::{ActiveContact, ContactError, ContactSet, ContactSolver, Obstacle};
+use crate::contact::{ActiveContact, Committed, ContactError, ContactSet, ContactSolver, Obstacle};
 use crate::linalg::CholeskyError;
 use crate::linkage::body_state::{loads_at, norm, prescribed_at};
 use crate::linkage::{lagrange_weights, Body, IncrementSize};
@@ -47,6 +48,10 @@ impl ContactSolver {
             self.active = ContactSet::default();
             self.normals.clear();
             self.path = vec![(0.0, self.parts.iter().map(|p| p.u.clone()).collect())];
+            if let Some(h) = self.friction.as_mut() {
+                h.clear();
+                h.offsets = obstacles.iter().map(|o| o.offset_at(0.0, steps)).collect();
+            }
         }
         if let Some(c) = self.condensed.as_mut() {
             c.start_step(step, steps, restart);
@@ -94,6 +99,26 @@ impl ContactSolver {
                     if t >= end {
                         break;
                     }
+                    // Friction's history moves on with each converged increment (the end of
+                    // the step is committed once it is reported).
+                    self.commit_friction(bodies, obstacles, t, steps, step);
+                }
+                Err(e) if self.friction.is_some() && gives_up(&e, &size, max_cuts) => {
+                    // With friction, a body that will not settle may be one pushed along its
+                    // contacts beyond μ N: say so by name (judged where the attempt ended,
+                    // which has found the contacts the loads press it on).
+                    let sliding = self.sliding(bodies, obstacles, step, steps);
+                    self.restore(saved);
+                    if let Some(sliding) = sliding {
+                        return Err(sliding);
+                    }
+                    if !retried(&e) {
+                        return Err(e);
+                    }
+                    self.leave_condensed()?;
+                    if !size.failed(max_cuts) {
+                        return Err(cut_to(e, step, &size));
+                    }
                 }
                 Err(e) if retried(&e) => {
                     if let ContactError::NotConverged { history, .. } = &e {
@@ -109,7 +134,139 @@ impl ContactSolver {
             }
         }
         out.cuts = size.cuts;
-        self.report(bodies, obstacles, step, steps, out)
+        let reported = self.report(bodies, obstacles, step, steps, out)?;
+        self.commit_friction(bodies, obstacles, end, steps, step);
+        Ok(reported)
+    }
+
+    /// The sliding of a body at `step` of `steps`, from the current state: a body whose
+    /// applied loads at the step have a part along its contacts (perpendicular to the sum of
+    /// their normal forces) beyond the `Σ μ f_N` they hold there. `None` when no body is.
+    fn sliding(
+        &mut self,
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        step: usize,
+        steps: usize,
+    ) -> Option<ContactError> {
+        self.friction.as_ref()?;
+        let t = step as Real;
+        let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
+        // The contacts where the attempt ended (the set it solved last is not kept).
+        let found = self.look(bodies, &self.active.clone(), &offsets);
+        let history = self.friction.as_ref()?;
+        let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
+        let (tolerance, max_iterations) = newton_limits(bodies);
+        let problem = Problem {
+            bodies,
+            geometry: &self.geometry,
+            set: &found,
+            forces: &forces,
+            offsets: &offsets,
+            step,
+            tolerance,
+            max_iterations,
+            move_cap: self.move_cap,
+            force_floor: self.force_floor(),
+            friction: Some(history),
+        };
+        let mut normals = self.normals.clone();
+        let evaluated = problem.evaluate(&mut normals, &self.parts);
+        // Per body: the mean direction its contacts press it along, and the largest μ among
+        // them. Where the attempt ended the depths (and so the normal forces) are those of a
+        // state out of balance; the load's own normal part is what the contacts must carry.
+        let mut normal = vec![Vector3::<Real>::zeros(); bodies.len()];
+        let mut mu = vec![0.0; bodies.len()];
+        for e in &evaluated.list {
+            let Some(n) = e.normal else { continue };
+            let (key, _) = friction_key(&e.contact);
+            let (m, _) = history.law(&key);
+            for &(b, _, w) in &e.nodes {
+                normal[b] += n * w;
+                mu[b] = Real::max(mu[b], m);
+            }
+        }
+        let mut worst: Option<(usize, Real, Real)> = None;
+        for (b, body) in bodies.iter().enumerate() {
+            let d = self.parts[b].dofs.dofs_per_node;
+            let mut load = Vector3::zeros();
+            for node in 0..body.nodes.len() {
+                load += crate::linkage::body_state::node_vector(&forces[b], d, node);
+            }
+            let Some(n) = normal[b].try_normalize(0.0) else {
+                continue;
+            };
+            let along = (load - n * load.dot(&n)).norm();
+            let capacity = mu[b] * load.dot(&n).abs();
+            if along > capacity * (1.0 + 1e-9)
+                && worst.is_none_or(|(_, a, c)| along - capacity > a - c)
+            {
+                worst = Some((b, along, capacity));
+            }
+        }
+        let (b, load, capacity) = worst?;
+        Some(ContactError::Sliding {
+            step,
+            body: bodies[b].name.clone(),
+            load,
+            capacity,
+        })
+    }
+
+    /// Commit friction's history at the converged state at pseudo-time `t` of `steps`: each
+    /// active contact's tangential force and slip, the displacements and obstacle offsets
+    /// (relative motion is measured from here on). A contact no longer active forgets its
+    /// history.
+    fn commit_friction(
+        &mut self,
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        t: Real,
+        steps: usize,
+        step: usize,
+    ) {
+        let Some(history) = self.friction.as_ref() else {
+            return;
+        };
+        let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
+        let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
+        let (tolerance, max_iterations) = newton_limits(bodies);
+        let problem = Problem {
+            bodies,
+            geometry: &self.geometry,
+            set: &self.active,
+            forces: &forces,
+            offsets: &offsets,
+            step,
+            tolerance,
+            max_iterations,
+            move_cap: self.move_cap,
+            force_floor: self.force_floor(),
+            friction: Some(history),
+        };
+        let mut normals = self.normals.clone();
+        let evaluated = problem.evaluate(&mut normals, &self.parts);
+        let mut committed = HashMap::new();
+        for e in &evaluated.list {
+            let Some(tangential) = &e.tangential else {
+                continue;
+            };
+            let (key, _) = friction_key(&e.contact);
+            let before = history.committed.get(&key).copied().unwrap_or_default();
+            committed.insert(
+                key,
+                Committed {
+                    force: tangential.force,
+                    slip: before.slip + tangential.slip,
+                },
+            );
+        }
+        let u = self.parts.iter().map(|p| p.u.clone()).collect();
+        if let Some(history) = self.friction.as_mut() {
+            history.committed = committed;
+            history.u = u;
+            history.offsets = offsets;
+        }
     }
 
     /// The state an increment starts from.
@@ -226,6 +383,7 @@ impl ContactSolver {
             max_iterations,
             move_cap: self.move_cap,
             force_floor: self.force_floor(),
+            friction: self.friction.as_ref(),
         };
         let mut normals = self.normals.clone();
         let evaluated = problem.evaluate(&mut normals, &self.parts);
@@ -234,6 +392,12 @@ impl ContactSolver {
             .out_of_balance(&problem, &self.parts, &evaluated);
         norm(&r)
     }
+}
+
+/// Whether the failure `e` ends the step: not retried, or retried at the smallest increment
+/// `max_cuts` allows.
+fn gives_up(e: &ContactError, size: &IncrementSize, max_cuts: usize) -> bool {
+    !retried(e) || size.depth >= max_cuts
 }
 
 /// Whether a failed increment is retried with half the increment: Newton did not converge,

@@ -3,6 +3,10 @@
 pub use self::boundary::boundary_loop;
 pub use self::contact_set::{ActiveContact, ContactSet, NodeContact, Target};
 pub use self::error::ContactError;
+pub use self::friction::{
+    return_mapping, Committed, FrictionHistory, FrictionKey, FrictionPair, FrictionSettings,
+    SlipState, Tangential,
+};
 pub use self::mesh_orientation::{orient_outward, MeshProblem, Orientation};
 pub use self::obstacle::{Obstacle, ObstacleShape};
 pub use self::obstacles::{mesh_collider, primitive_collider, ObstacleProjection, Obstacles};
@@ -24,6 +28,7 @@ mod cylinder_rim;
 mod detect;
 mod error;
 mod evaluate;
+mod friction;
 mod increments;
 mod mesh_orientation;
 mod obstacle;

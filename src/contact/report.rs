@@ -1,8 +1,9 @@
 //! The report of a settled step: each body's state, the contacts each node receives, the totals per pair, and the warnings.
 
+use crate::contact::evaluate::friction_key;
 use crate::contact::evaluate::Evaluation;
 use crate::contact::settle::{BodyPart, Problem};
-use crate::contact::{ContactError, NodeContact, Target};
+use crate::contact::{ContactError, NodeContact, SlipState, Target};
 use crate::linkage::body_state::{internal_force_vector, member_response_at, norm};
 use crate::linkage::{post_process, StepState};
 use crate::Real;
@@ -37,6 +38,10 @@ pub struct ContactStep {
     /// Per body, the total contact force it receives from each obstacle or body it touches,
     /// as (name of the other, force in N), in name order.
     pub totals: Vec<Vec<(String, Vector3<Real>)>>,
+    /// Contacts that stick (friction holds them).
+    pub sticking: usize,
+    /// Contacts that slip (at `μ f_N`; frictionless contacts slip always).
+    pub slipping: usize,
 }
 
 /// States, contacts and penetration of the settled step of `p` into `out`, from its contacts
@@ -53,9 +58,23 @@ pub(crate) fn finish(
     let mut touched: Vec<Vec<NodeContact>> = vec![Vec::new(); bodies.len()];
     for e in &list {
         let name = p.geometry.target_name(bodies, e.contact.with).to_string();
-        let force = e
-            .normal
-            .map_or(Vector3::zeros(), |n| e.penalty.force(e.depth, &n));
+        let n = e.normal.unwrap_or_default();
+        let normal_force = n * e.normal_force();
+        let (tangential, state, slip) = match &e.tangential {
+            Some(t) => {
+                let (key, _) = friction_key(&e.contact);
+                let before = p
+                    .friction
+                    .and_then(|h| h.committed.get(&key))
+                    .map_or(Vector3::zeros(), |c| c.slip);
+                (t.force, t.state, before + t.slip)
+            }
+            None => (Vector3::zeros(), SlipState::Slip, Vector3::zeros()),
+        };
+        match state {
+            SlipState::Stick => out.sticking += 1,
+            SlipState::Slip => out.slipping += 1,
+        }
         out.max_penetration = out.max_penetration.max(e.depth);
         let part = &parts[e.contact.body];
         // An obstacle's sharp point presses the body's surface nodes: all of them touch it.
@@ -87,13 +106,25 @@ pub(crate) fn finish(
             match list.iter_mut().find(|t| t.node == node && t.with == with) {
                 Some(t) => {
                     t.depth = t.depth.max(depth);
-                    t.force += force * w;
+                    t.force += e.force() * w;
+                    // Summed as vectors here; made a unit normal and its size below.
+                    t.normal += normal_force * w;
+                    t.tangential_force += tangential * w;
+                    t.slip += slip * w;
+                    if state == SlipState::Slip {
+                        t.state = SlipState::Slip;
+                    }
                 }
                 None => list.push(NodeContact {
                     node,
                     with,
                     depth,
-                    force: force * w,
+                    force: e.force() * w,
+                    normal: normal_force * w,
+                    normal_force: 0.0,
+                    tangential_force: tangential * w,
+                    state,
+                    slip: slip * w,
                 }),
             }
         }
@@ -148,6 +179,13 @@ pub(crate) fn finish(
         for c in &mut contacts {
             for k in d..3 {
                 c.force[k] = 0.0;
+                c.normal[k] = 0.0;
+                c.tangential_force[k] = 0.0;
+                c.slip[k] = 0.0;
+            }
+            c.normal_force = c.normal.norm();
+            if c.normal_force > 0.0 {
+                c.normal /= c.normal_force;
             }
         }
         contacts.sort_by(|a, b| a.node.cmp(&b.node).then(a.with.cmp(&b.with)));

@@ -1,9 +1,10 @@
 //! The scene's `[contact]` settings.
 
+use crate::contact::FrictionSettings;
 use crate::Real;
 
 /// How contact is treated in a scene (`[contact]`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ContactSettings {
     /// Penalty stiffness, N/m of penetration; `None`: the default rule of
     /// [`crate::contact::default_penalty`].
@@ -17,6 +18,8 @@ pub struct ContactSettings {
     /// on its contact candidates (`true`, the default), rather than factoring the coupled
     /// system of all bodies at every contact iteration.
     pub condense: bool,
+    /// Coulomb friction of the contact pairs (frictionless by default).
+    pub friction: FrictionSettings,
 }
 
 impl Default for ContactSettings {
@@ -26,6 +29,7 @@ impl Default for ContactSettings {
             tolerance: None,
             max_iterations: 50,
             condense: true,
+            friction: FrictionSettings::default(),
         }
     }
 }

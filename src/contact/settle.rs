@@ -9,7 +9,7 @@ use crate::contact::report::{finish, ContactStep};
 use crate::contact::start::{no_start_overlap, one_dimension};
 use crate::contact::{
     default_penalty, penetration_tolerance, ActiveContact, ContactError, ContactSet,
-    ContactSettings, Obstacle, Penalty,
+    ContactSettings, FrictionHistory, Obstacle, Penalty,
 };
 use crate::linkage::body_state::{loads_at, node_vector, prescribed_at};
 use crate::linkage::{
@@ -82,6 +82,8 @@ pub(crate) struct Problem<'a> {
     pub(crate) move_cap: Real,
     /// The smallest force scale of a residual, N.
     pub(crate) force_floor: Real,
+    /// Friction and its history (`None`: every pair frictionless).
+    pub(crate) friction: Option<&'a FrictionHistory>,
 }
 
 impl Problem<'_> {
@@ -98,6 +100,7 @@ impl Problem<'_> {
             parts,
             self.set,
             self.offsets,
+            self.friction,
         )
     }
 
@@ -175,6 +178,9 @@ pub struct ContactSolver {
     /// if no contact holds it either.
     pub(crate) mechanism: Option<Box<Mechanism>>,
     pub(crate) settings: ContactSettings,
+    /// Friction of the pairs and its history at the last converged state (`None`: every
+    /// pair frictionless).
+    pub(crate) friction: Option<FrictionHistory>,
     /// The contact set of the last solved step (the next step starts from it).
     pub(crate) active: ContactSet,
     /// The last normal seen per contact (used when a node lies exactly on the surface).
@@ -257,7 +263,31 @@ impl ContactSolver {
         let t = Instant::now();
         let coupled = CoupledSolver::new(&parts, node_offsets, condensed.is_none(), iterative)?;
         times.symbolic += t.elapsed().as_secs_f64();
+        let friction = settings.friction.any().then(|| {
+            let names: Vec<&str> = obstacles
+                .iter()
+                .map(|o| o.name.as_str())
+                .chain(bodies.iter().map(|b| b.name.as_str()))
+                .collect();
+            let laws = bodies
+                .iter()
+                .map(|b| {
+                    names
+                        .iter()
+                        .map(|other| settings.friction.law(&b.name, other))
+                        .collect()
+                })
+                .collect();
+            let dofs: Vec<usize> = bodies.iter().map(|b| b.dof_count()).collect();
+            FrictionHistory::new(
+                laws,
+                obstacles.len(),
+                &dofs,
+                vec![Vector3::zeros(); obstacles.len()],
+            )
+        });
         Ok(ContactSolver {
+            friction,
             move_cap: bodies
                 .iter()
                 .filter(|b| !b.members.is_empty())
@@ -333,7 +363,7 @@ impl ContactSolver {
     }
 
     /// The contacts of `found` after keeping patches against `solved`, timed as a query.
-    fn look(
+    pub(crate) fn look(
         &mut self,
         bodies: &[Body],
         solved: &ContactSet,
@@ -461,6 +491,7 @@ impl ContactSolver {
             max_iterations,
             move_cap: self.move_cap,
             force_floor: self.force_floor(),
+            friction: self.friction.as_ref(),
         };
         let evaluated = problem.evaluate(&mut self.normals, &self.parts);
         out.negative_pivots = self.coupled.negative_pivots;
@@ -502,6 +533,7 @@ impl ContactSolver {
             max_iterations,
             move_cap: self.move_cap,
             force_floor: self.force_floor(),
+            friction: self.friction.as_ref(),
         };
         if let Some(condensed) = self.condensed.as_mut() {
             let done = condensed.newton(

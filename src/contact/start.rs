@@ -59,7 +59,15 @@ pub(crate) fn no_start_overlap(
 ) -> Result<(), ContactError> {
     let offsets = vec![Vector3::zeros(); geometry.obstacles.len()];
     let set = geometry.query(bodies, parts, &offsets);
-    let evaluated = evaluate(geometry, &mut HashMap::new(), bodies, parts, &set, &offsets);
+    let evaluated = evaluate(
+        geometry,
+        &mut HashMap::new(),
+        bodies,
+        parts,
+        &set,
+        &offsets,
+        None,
+    );
     // Per body the deepest contact beyond its tolerance.
     let mut deepest: Vec<Option<Deepest>> = vec![None; bodies.len()];
     for e in &evaluated.list {

@@ -6,7 +6,7 @@ pub use self::block_jacobi::{BlockJacobi, SingularBlock};
 pub use self::cholesky::{CholeskyError, SparseCholesky};
 pub use self::conjugate_gradient::{conjugate_gradient, CgReport, CgSettings, Preconditioner};
 pub use self::ldlt::SparseLdlt;
-pub use self::low_rank::{LowRankUpdate, Removal, SingularUpdate};
+pub use self::low_rank::{LowRankCorrection, LowRankUpdate, Removal, SingularUpdate, SparseColumn};
 pub use self::multigrid::{MultigridError, SmoothedAggregation};
 pub use self::symmetric_csr::{dot, SymmetricCsr};
 

@@ -40,6 +40,10 @@ pub const BLACK: Rgb = Rgb(0.0, 0.0, 0.0);
 pub const FORCE_BLUE: Rgb = Rgb::bytes(16, 64, 220);
 /// Contact forces.
 pub const CONTACT_ORANGE: Rgb = Rgb::bytes(235, 120, 0);
+/// Tangential force of a sticking contact.
+pub const STICK_GREEN: Rgb = Rgb::bytes(0, 150, 70);
+/// Tangential force of a slipping contact.
+pub const SLIP_MAGENTA: Rgb = Rgb::bytes(200, 0, 140);
 /// The undeformed shape.
 pub const GHOST_GREY: Rgb = Rgb::bytes(150, 150, 150);
 /// Text.

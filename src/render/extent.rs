@@ -28,6 +28,9 @@ pub struct RunExtent {
     pub force_scale: Real,
     /// Arrow length per newton of contact force, m/N.
     pub contact_scale: Real,
+    /// Whether some contact of the run has a tangential (friction) force: its arrows and
+    /// legend are drawn.
+    pub friction: bool,
     /// Largest |axial stress| of a member over the run, Pa.
     pub stress_limit: Real,
     /// Largest |mean stress of the members at a node| over the run (surface colours), Pa.
@@ -130,6 +133,7 @@ impl RunExtent {
         let mut max_displacement: Real = 0.0;
         let mut max_force: Real = 0.0;
         let mut max_contact: Real = 0.0;
+        let mut friction = false;
         let mut stress_limit: Real = 0.0;
         let mut node_stress_limit: Real = 0.0;
         for r in steps {
@@ -142,6 +146,7 @@ impl RunExtent {
                 }
                 for c in &b.contacts {
                     max_contact = max_contact.max(vec3(&c.force).norm());
+                    friction |= c.tangential_force.iter().any(|t| *t != 0.0);
                 }
                 for s in &b.stresses {
                     stress_limit = stress_limit.max(s.abs());
@@ -183,7 +188,12 @@ impl RunExtent {
                     .loads
                     .iter()
                     .map(|l| (l.node, &l.force, force_scale))
-                    .chain(b.contacts.iter().map(|c| (c.node, &c.force, contact_scale)));
+                    .chain(b.contacts.iter().map(|c| (c.node, &c.force, contact_scale)))
+                    .chain(
+                        b.contacts
+                            .iter()
+                            .map(|c| (c.node, &c.tangential_force, contact_scale)),
+                    );
                 for (node, f, scale) in forces {
                     let (t, h) = arrow_ends(at(node.saturating_sub(1)), vec3(f), scale, *centre);
                     for p in [t, h] {
@@ -205,6 +215,7 @@ impl RunExtent {
             max_force,
             force_scale,
             contact_scale,
+            friction,
             stress_limit,
             node_stress_limit,
             last_step,

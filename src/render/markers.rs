@@ -1,14 +1,15 @@
 //! Marks drawn over the bodies: supports, applied forces and contact forces.
 
-use crate::render::colour_scale::{CONTACT_ORANGE, FORCE_BLUE};
+use crate::render::colour_scale::{CONTACT_ORANGE, FORCE_BLUE, SLIP_MAGENTA, STICK_GREEN};
 use crate::render::deformed_body::{vec3, DeformedBody};
 use crate::render::extent::arrow_ends;
 use crate::render::{Primitive, RunExtent};
 use nalgebra::Vector3;
 
 /// Supports (a black mark across each held direction, on the outside of the body), applied
-/// forces (blue arrows, one length scale for the whole run) and contact forces (orange
-/// arrows) of one body. `depth_test`: hide those behind surfaces (3D).
+/// forces (blue arrows, one length scale for the whole run), contact forces (orange arrows)
+/// and their tangential (friction) part (green where the contact sticks, magenta where it
+/// slips) of one body. `depth_test`: hide those behind surfaces (3D).
 pub fn markers(body: &DeformedBody, extent: &RunExtent, depth_test: bool) -> Vec<Primitive> {
     let mut out = Vec::new();
     for s in &body.model.supports {
@@ -57,7 +58,21 @@ pub fn markers(body: &DeformedBody, extent: &RunExtent, depth_test: bool) -> Vec
                 .contacts
                 .iter()
                 .map(|c| (c.node, &c.force, extent.contact_scale, CONTACT_ORANGE, 2.0)),
-        );
+        )
+        .chain(body.result.contacts.iter().map(|c| {
+            let colour = if c.state == "stick" {
+                STICK_GREEN
+            } else {
+                SLIP_MAGENTA
+            };
+            (
+                c.node,
+                &c.tangential_force,
+                extent.contact_scale,
+                colour,
+                2.0,
+            )
+        }));
     for (node, f, scale, colour, width) in forces {
         if f.iter().all(|x| *x == 0.0) {
             continue;

@@ -1,6 +1,8 @@
 //! The furniture of a frame: its layout, the colour bar and the labels.
 
-use crate::render::colour_scale::{colour_at, format_si, si_unit, BLACK, FORCE_BLUE, INK};
+use crate::render::colour_scale::{
+    colour_at, format_si, si_unit, BLACK, FORCE_BLUE, INK, SLIP_MAGENTA, STICK_GREEN,
+};
 use crate::render::text::{draw_text, text_width};
 use crate::render::{Frame, Rgb};
 use crate::Real;
@@ -64,6 +66,8 @@ pub struct Caption {
     pub stress_bar: Option<(String, Real)>,
     /// Largest applied force over the run, N (0: no force legend).
     pub max_force: Real,
+    /// Whether the run has friction forces (their legend: sticking and slipping).
+    pub friction: bool,
 }
 
 fn fmt_number(v: Real) -> String {
@@ -232,8 +236,10 @@ pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
             small,
             INK,
         );
+        let mut next = ly + 34.0 * ui;
         if c.max_force > 0.0 {
-            legend_arrow(frame, x0, ly + 34.0 * ui, ui);
+            legend_arrow(frame, x0, ly + 34.0 * ui, ui, FORCE_BLUE);
+            next += 56.0 * ui;
             draw_text(
                 &mut frame.pixmap,
                 "applied force",
@@ -251,12 +257,29 @@ pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
                 Rgb(0.35, 0.35, 0.38),
             );
         }
+        if c.friction {
+            for (label, colour) in [
+                ("friction, sticking", STICK_GREEN),
+                ("friction, slipping", SLIP_MAGENTA),
+            ] {
+                legend_arrow(frame, x0, next, ui, colour);
+                draw_text(
+                    &mut frame.pixmap,
+                    label,
+                    x0 + 44.0 * ui,
+                    next + 6.0 * ui,
+                    small,
+                    INK,
+                );
+                next += 28.0 * ui;
+            }
+        }
     }
 }
 
-fn legend_arrow(frame: &mut Frame, x: f32, y: f32, ui: f32) {
+fn legend_arrow(frame: &mut Frame, x: f32, y: f32, ui: f32, colour: Rgb) {
     let mut paint = Paint::default();
-    paint.set_color(FORCE_BLUE.with_alpha(1.0));
+    paint.set_color(colour.with_alpha(1.0));
     paint.anti_alias = true;
     let mut pb = PathBuilder::new();
     pb.move_to(x, y);

@@ -130,6 +130,7 @@ pub fn draw_frame(
             magnification: extent.magnification,
             stress_bar,
             max_force: extent.max_force,
+            friction: extent.friction,
         },
     );
     Ok(frame)

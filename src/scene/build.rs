@@ -8,6 +8,7 @@ use crate::linkage::{
     NodalLoad, PathMethod, Scatter, Schedule, SolverChoice, SolverSettings, Support,
 };
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
+use crate::scene::contact_pairs::friction_settings;
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::prepared_body::prepared_geometry;
@@ -248,6 +249,16 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
             ));
         }
         obstacles.push(obstacle);
+    }
+    let mut contact = contact;
+    if let Some(c) = &spec.contact {
+        let names: Vec<&str> = bodies
+            .iter()
+            .map(|b| b.name.as_str())
+            .chain(obstacles.iter().map(|o| o.name.as_str()))
+            .collect();
+        contact.friction =
+            friction_settings(c.get_ref(), &names, c.span()).map_err(|(span, e)| at(span, e))?;
     }
     let members = bodies.iter().map(|b| b.members.len()).sum();
     let output = OutputSettings {

@@ -31,6 +31,7 @@ pub mod batch;
 mod bounds;
 mod build;
 mod check;
+mod contact_pairs;
 mod driver;
 mod instability;
 mod link_lines;

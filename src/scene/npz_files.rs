@@ -96,6 +96,28 @@ pub(crate) fn step_npz(step: &StepResult, dimensions: &[usize]) -> std::io::Resu
             )?;
             out.i64s(&key("fallen"), &[f.fallen.len()], f.fallen.iter().copied())?;
         }
+        out.f64s(
+            &key("contacts_normal"),
+            &[c.len(), d],
+            c.iter().flat_map(|c| &c.normal),
+        )?;
+        out.f64s(
+            &key("contacts_normal_force"),
+            &[c.len()],
+            c.iter().map(|c| &c.normal_force),
+        )?;
+        out.f64s(
+            &key("contacts_tangential_force"),
+            &[c.len(), d],
+            c.iter().flat_map(|c| &c.tangential_force),
+        )?;
+        let states: Vec<&str> = c.iter().map(|c| c.state.as_str()).collect();
+        out.strs(&key("contacts_state"), &[c.len()], &states)?;
+        out.f64s(
+            &key("contacts_slip"),
+            &[c.len(), d],
+            c.iter().flat_map(|c| &c.slip),
+        )?;
     }
     out.finish()
 }
@@ -168,17 +190,48 @@ pub(crate) fn read_step_npz(bytes: &[u8], model: &ModelFile) -> Result<StepResul
         let force = npz
             .f64s(&key("contacts_force"))?
             .rows(&key("contacts_force"), Some(c), d)?;
+        let normal =
+            npz.f64s(&key("contacts_normal"))?
+                .rows(&key("contacts_normal"), Some(c), d)?;
+        let normal_force = npz
+            .f64s(&key("contacts_normal_force"))?
+            .list(&key("contacts_normal_force"), Some(c))?;
+        let tangential = npz.f64s(&key("contacts_tangential_force"))?.rows(
+            &key("contacts_tangential_force"),
+            Some(c),
+            d,
+        )?;
+        let state = npz
+            .strings(&key("contacts_state"))?
+            .list(&key("contacts_state"), Some(c))?;
+        let slip = npz
+            .f64s(&key("contacts_slip"))?
+            .rows(&key("contacts_slip"), Some(c), d)?;
         let contacts = nodes
             .into_iter()
             .zip(with)
             .zip(depth)
             .zip(force)
-            .map(|(((node, with), depth), force)| ContactForce {
-                node,
-                with,
-                depth,
-                force,
-            })
+            .zip(normal.into_iter().zip(normal_force))
+            .zip(tangential.into_iter().zip(state).zip(slip))
+            .map(
+                |(
+                    ((((node, with), depth), force), (normal, normal_force)),
+                    ((tangential_force, state), slip),
+                )| {
+                    ContactForce {
+                        node,
+                        with,
+                        depth,
+                        force,
+                        normal,
+                        normal_force,
+                        tangential_force,
+                        state,
+                        slip,
+                    }
+                },
+            )
             .collect();
         bodies.push(BodyResult {
             name,
@@ -415,6 +468,11 @@ mod tests {
                         with: "flöor".into(),
                         depth: 1e-6,
                         force: vec![0.0, 2.0],
+                        normal: vec![0.0, 1.0],
+                        normal_force: 1.5,
+                        tangential_force: vec![tricky[0], 0.0],
+                        state: "stick".into(),
+                        slip: vec![tricky[2], 0.0],
                     }],
                     fracture: None,
                 },

@@ -15,7 +15,7 @@ pub struct NodeForce {
 }
 
 /// A node pressing on another body or an obstacle (filled by contact; empty without).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ContactForce {
     /// 1-based node number.
     pub node: usize,
@@ -23,8 +23,23 @@ pub struct ContactForce {
     pub with: String,
     /// Penetration depth, m.
     pub depth: Real,
-    /// Force the node receives, N.
+    /// Force the node receives, N: `normal_force · normal + tangential_force`.
     pub force: Vec<Real>,
+    /// Unit normal of the contact, from the surface towards the node.
+    #[serde(default)]
+    pub normal: Vec<Real>,
+    /// Normal force the node receives, N (≥ 0).
+    #[serde(default)]
+    pub normal_force: Real,
+    /// Tangential (friction) force the node receives, N.
+    #[serde(default)]
+    pub tangential_force: Vec<Real>,
+    /// `"stick"` or `"slip"` (frictionless contacts slip).
+    #[serde(default)]
+    pub state: String,
+    /// Slip of the node over what it touches, accumulated while the contact lasts, m.
+    #[serde(default)]
+    pub slip: Vec<Real>,
 }
 
 /// One body at one step, as written in `steps/NNNN.json`.
@@ -148,6 +163,12 @@ pub struct StepSummary {
     pub negative_pivots: usize,
     /// Contact iterations (0 without contact).
     pub contact_iterations: usize,
+    /// Contacts that stick (friction holds them; absent without contact).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub sticking: usize,
+    /// Contacts that slip (at μ times their normal force; frictionless contacts slip).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub slipping: usize,
     /// Conjugate-gradient iterations of the step's solves, all bodies (0 with the direct
     /// solver; a linear body solves all its load patterns before step 1 and counts them there).
     #[serde(default)]
@@ -309,4 +330,9 @@ impl BodyResult {
         .into_iter()
         .find_map(|(name, ok)| (!ok).then_some(name))
     }
+}
+
+/// Whether a count is zero (left out of the summary).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }

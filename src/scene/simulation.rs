@@ -49,11 +49,12 @@ impl<'w> Simulation<'w> {
             }
         }
         let solver = if world.has_contact() {
-            let contact = ContactSolver::new(&world.bodies, &world.obstacles, world.contact)
-                .map_err(|source| RunError::Contact {
-                    scene: world.source.clone(),
-                    source,
-                })?;
+            let contact =
+                ContactSolver::new(&world.bodies, &world.obstacles, world.contact.clone())
+                    .map_err(|source| RunError::Contact {
+                        scene: world.source.clone(),
+                        source,
+                    })?;
             WorldSolver::Contact(Box::new(contact))
         } else {
             let solvers = world
@@ -101,6 +102,8 @@ impl<'w> Simulation<'w> {
                 summary.negative_pivots = solved.negative_pivots;
                 summary.linear_iterations = solved.linear_iterations;
                 summary.contact_iterations = solved.contact_iterations;
+                summary.sticking = solved.sticking;
+                summary.slipping = solved.slipping;
                 summary.max_penetration = solved.max_penetration;
                 summary.warnings = solved.warnings;
                 for (body, totals) in world.bodies.iter().zip(&solved.totals) {
@@ -289,6 +292,8 @@ fn empty_summary(step: usize, load_factor: Real) -> StepSummary {
         negative_pivots: 0,
         residuals: Vec::new(),
         contact_iterations: 0,
+        sticking: 0,
+        slipping: 0,
         linear_iterations: 0,
         residual: 0.0,
         max_displacement: 0.0,
@@ -346,6 +351,11 @@ fn contact_forces(body: &Body, contacts: &[NodeContact]) -> Vec<ContactForce> {
             with: c.with.clone(),
             depth: c.depth,
             force: c.force.as_slice()[..d].to_vec(),
+            normal: c.normal.as_slice()[..d].to_vec(),
+            normal_force: c.normal_force,
+            tangential_force: c.tangential_force.as_slice()[..d].to_vec(),
+            state: c.state.name().to_string(),
+            slip: c.slip.as_slice()[..d].to_vec(),
         })
         .collect()
 }

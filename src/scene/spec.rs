@@ -48,6 +48,25 @@ pub struct ContactSpec {
     pub max_iterations: Option<usize>,
     /// Linear bodies factored once and condensed on their contact candidates (default true).
     pub condense: Option<bool>,
+    /// Coulomb coefficient μ of every contact pair (default 0: frictionless).
+    pub friction: Option<Real>,
+    /// Tangential stiffness of sticking, N/m of elastic slip (default: the normal penalty).
+    pub stick_stiffness: Option<Real>,
+    /// Pairs with their own friction.
+    #[serde(default)]
+    pub pairs: Vec<Spanned<ContactPairSpec>>,
+}
+
+/// `[[contact.pairs]]`: friction between two named bodies or obstacles.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactPairSpec {
+    /// The two names: bodies or obstacles.
+    pub between: Vec<String>,
+    /// Coulomb coefficient μ of the pair.
+    pub friction: Option<Real>,
+    /// Stick stiffness of the pair, N/m.
+    pub stick_stiffness: Option<Real>,
 }
 
 /// `[[obstacles]]`: a rigid obstacle (see `docs/SCENES.md`).

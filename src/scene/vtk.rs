@@ -4,10 +4,12 @@
 //! One `.vtu` holds every body of the scene: points are the deformed node positions (z = 0
 //! for 2D bodies), body after body; cells are the members as lines (VTK_LINE = 3), in member
 //! order, body after body, then the patches as triangles (VTK_TRIANGLE = 5). Point data:
-//! `displacement`, `applied_force`, `reaction`, `contact_force` (3 components, m or N) and
-//! `body` (1-based). Cell data: `axial_force` (N), `stress` (Pa), `overloaded` (0/1),
-//! `member` (1-based, 0 on triangles) and `body`; with breaking members also `broken` (0/1, 0 on
-//! triangles). A triangle carries the mean axial force and
+//! `displacement`, `applied_force`, `reaction`, `contact_force`, `tangential_force` (its
+//! friction part; 3 components, m or N), `contact_state` (0 no contact, 1 sticking, 2
+//! slipping; frictionless contacts slip) and `body` (1-based). Cell data: `axial_force` (N),
+//! `stress` (Pa), `overloaded` (0/1), `member` (1-based, 0 on triangles) and `body`; with
+//! breaking members also `broken` (0/1, 0 on triangles). A triangle carries the mean axial
+//! force and
 //! stress of those of its three edges that are members (0 if none) and `overloaded` = 0.
 //!
 //! A scene with rigid obstacles also gets `vtk/obstacles_NNNN.vtu` per stored step, part 1 of
@@ -176,6 +178,8 @@ pub(crate) fn vtu_file(
     let mut applied = Vec::new();
     let mut reaction = Vec::new();
     let mut contact = Vec::new();
+    let mut tangential = Vec::new();
+    let mut contact_state = Vec::new();
     let mut point_body = Vec::new();
     let mut lines: Vec<Cell> = Vec::new();
     let mut triangles = Vec::new();
@@ -193,6 +197,18 @@ pub(crate) fn vtu_file(
             n,
             r.contacts.iter().map(|c| (c.node, &c.force)),
         ));
+        tangential.extend(node_vectors(
+            n,
+            r.contacts.iter().map(|c| (c.node, &c.tangential_force)),
+        ));
+        let mut states = vec![0usize; n];
+        for c in &r.contacts {
+            if let Some(s) = states.get_mut(c.node.wrapping_sub(1)) {
+                // Slip wins over stick where a node touches two things.
+                *s = (*s).max(if c.state == "stick" { 1 } else { 2 });
+            }
+        }
+        contact_state.extend(states);
         point_body.extend(std::iter::repeat_n(k + 1, n));
         let overloaded = overloaded_flags(m, r);
         let broken = broken_flags(m, r);
@@ -253,6 +269,8 @@ pub(crate) fn vtu_file(
     a.vectors("applied_force", &applied);
     a.vectors("reaction", &reaction);
     a.vectors("contact_force", &contact);
+    a.vectors("tangential_force", &tangential);
+    a.ints("contact_state", contact_state.iter().copied());
     a.ints("body", point_body.iter().copied());
     a.xml
         .push_str("      </PointData>\n      <CellData Scalars=\"stress\">\n");

@@ -5,13 +5,45 @@ use crate::Real;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 
-/// One active contact of the condensed problem: its penalty (N/m) and its row of `G`, the
-/// change of penetration per unit displacement, as (body, candidate slot, coefficient).
+/// One row of the condensed problem: an active contact's normal (or, with friction, one of
+/// its tangent directions): its stiffness (N/m) and its row of `G`, the relative motion along
+/// the direction per unit displacement, as (body, candidate slot, coefficient).
 pub(crate) struct ContactRow {
-    /// Penalty stiffness of the contact, N/m.
+    /// Stiffness of the row against its own motion, N/m (the penalty for a normal row).
     pub penalty: Real,
     /// The row's nonzero entries, as (body, candidate slot, coefficient).
     pub entries: Vec<(usize, usize, Real)>,
+    /// Stiffness against the motion of other rows of the same contact (friction), as (row,
+    /// N/m): the contact's `κ` is then a block, unsymmetric while it slips.
+    pub coupling: Vec<(usize, Real)>,
+}
+
+/// `κ⁻¹ + G C Gᵀ` factored, or, when some contact's `κ` is a block (friction), `I + κ G C Gᵀ`
+/// and `κ`: `apply` gives `(κ⁻¹ + G C Gᵀ)⁻¹ x = (I + κ G C Gᵀ)⁻¹ κ x` either way.
+enum Inverse {
+    Symmetric(faer::linalg::solvers::Llt<Real>),
+    General {
+        lu: faer::linalg::solvers::PartialPivLu<Real>,
+        kappa: Vec<Vec<(usize, Real)>>,
+    },
+}
+
+impl Inverse {
+    fn solve_in_place(&self, mut x: faer::MatMut<'_, Real>) {
+        match self {
+            Inverse::Symmetric(llt) => llt.solve_in_place(x),
+            Inverse::General { lu, kappa } => {
+                let mut y = Mat::<Real>::zeros(x.nrows(), x.ncols());
+                for (i, row) in kappa.iter().enumerate() {
+                    for j in 0..x.ncols() {
+                        y[(i, j)] = row.iter().map(|&(c, k)| k * x[(c, j)]).sum();
+                    }
+                }
+                lu.solve_in_place(y.as_mut());
+                x.copy_from(&y);
+            }
+        }
+    }
 }
 
 /// A Newton correction of the condensed contact problem.
@@ -36,13 +68,15 @@ pub(crate) struct Correction {
 /// by their out-of-balance over `stabilisation`, as the coupled solve does.
 pub(crate) struct ContactJacobian {
     rows: Vec<ContactRow>,
-    llt: faer::linalg::solvers::Llt<Real>,
+    llt: Inverse,
     /// `[B | A⁻¹ B]`, k × 2r.
     b_psi: Mat<Real>,
     /// First rigid amplitude of each body in the global list.
     first: Vec<usize>,
     /// Eigenvalues and eigenvectors of `Bᵀ A⁻¹ B` (none without rigid motions).
     eigen: Option<nalgebra::SymmetricEigen<Real, nalgebra::Dyn>>,
+    /// LU of `Bᵀ A⁻¹ B` itself when it is unsymmetric (friction).
+    rigid_lu: Option<nalgebra::LU<Real, nalgebra::Dyn, nalgebra::Dyn>>,
     stabilisation: Real,
 }
 
@@ -66,7 +100,10 @@ impl ContactJacobian {
                 }
             }
         }
-        // A = κ⁻¹ + G W, column by column (W's columns are contiguous).
+        let general = rows
+            .iter()
+            .any(|r| !r.coupling.is_empty() || r.penalty.is_nan() || r.penalty <= 0.0);
+        // A = κ⁻¹ + G W, column by column (W's columns are contiguous); G W alone with blocks.
         let mut a = Mat::<Real>::zeros(k, k);
         for e2 in 0..k {
             let columns: Vec<Option<&[Real]>> = w
@@ -86,7 +123,9 @@ impl ContactJacobian {
                 }
                 col[e1] += sum;
             }
-            col[e2] += 1.0 / rows[e2].penalty;
+            if !general {
+                col[e2] += 1.0 / rows[e2].penalty;
+            }
         }
         drop(w);
         // Symmetrize round-off before the factorization.
@@ -97,9 +136,52 @@ impl ContactJacobian {
                 a[(j, i)] = v;
             }
         }
-        let llt = a
-            .llt(Side::Lower)
-            .map_err(|e| format!("the contact matrix is not positive definite: {e:?}"))?;
+        if general {
+            // The frictionless path finds `κ⁻¹ + G C Gᵀ` not positive definite where the
+            // candidates' compliance is not (then the coupled solve takes over): with friction,
+            // the same test on the rows' own stiffnesses.
+            let largest = rows.iter().map(|r| r.penalty).fold(0.0, Real::max);
+            let mut test = a.clone();
+            for (i, row) in rows.iter().enumerate() {
+                test[(i, i)] += 1.0
+                    / if row.penalty > 0.0 {
+                        row.penalty
+                    } else {
+                        largest
+                    };
+            }
+            test.llt(Side::Lower)
+                .map_err(|e| format!("the contact matrix is not positive definite: {e:?}"))?;
+        }
+        let llt = if general {
+            // κ per row: its own stiffness and those against the contact's other rows.
+            let kappa: Vec<Vec<(usize, Real)>> = rows
+                .iter()
+                .enumerate()
+                .map(|(i, r)| {
+                    std::iter::once((i, r.penalty))
+                        .chain(r.coupling.iter().copied())
+                        .filter(|&(_, v)| v != 0.0)
+                        .collect()
+                })
+                .collect();
+            // M = I + κ (G W).
+            let mut m = Mat::<Real>::identity(k, k);
+            for (i, row) in kappa.iter().enumerate() {
+                for j in 0..k {
+                    m[(i, j)] += row.iter().map(|&(c, v)| v * a[(c, j)]).sum::<Real>();
+                }
+            }
+            Inverse::General {
+                lu: m.partial_piv_lu(),
+                kappa,
+            }
+        } else {
+            Inverse::Symmetric(
+                a.llt(Side::Lower)
+                    .map_err(|e| format!("the contact matrix is not positive definite: {e:?}"))?,
+            )
+        };
         let mut first = Vec::with_capacity(bodies.len());
         let mut r = 0;
         for b in bodies {
@@ -123,6 +205,9 @@ impl ContactJacobian {
                 m[(i, j)] = (0..k).map(|e| b_psi[(e, i)] * b_psi[(e, r + j)]).sum();
             }
         }
+        // With slipping contacts `Bᵀ A⁻¹ B` is unsymmetric: the held rigid motions are decided
+        // on its symmetric part and, when all are held, solved with the whole of it.
+        let full = matches!(llt, Inverse::General { .. }).then(|| m.clone().lu());
         let m = (&m + m.transpose()) * 0.5;
         Ok(ContactJacobian {
             rows,
@@ -130,6 +215,7 @@ impl ContactJacobian {
             b_psi,
             first,
             eigen: (r > 0).then(|| m.symmetric_eigen()),
+            rigid_lu: full,
             stabilisation,
         })
     }
@@ -186,7 +272,15 @@ impl ContactJacobian {
                 };
                 x += v * (p / stiffness);
             }
-            dalpha.copy_from_slice(x.as_slice());
+            if !stabilised {
+                if let Some(x) = self.rigid_lu.as_ref().and_then(|lu| lu.solve(&g)) {
+                    dalpha.copy_from_slice(x.as_slice());
+                } else {
+                    dalpha.copy_from_slice(x.as_slice());
+                }
+            } else {
+                dalpha.copy_from_slice(x.as_slice());
+            }
         }
         // μ = μ₀ + Ψ δα; δf̂ = Φ₁ − Gᵀ μ.
         let mut fhat: Vec<Vec<Real>> = phi1.to_vec();

@@ -300,22 +300,58 @@ impl CondensedSolver {
         let mut rows = Vec::with_capacity(evaluated.list.len());
         for e in &evaluated.list {
             let Some(n) = e.normal else { continue };
-            let mut entries = Vec::with_capacity(12);
-            for &(b, node, w) in &e.nodes {
-                let dofs = &parts[b].dofs;
-                for k in 0..dofs.dofs_per_node {
-                    if let Some(i) = dofs.free_index(node, k) {
-                        match self.bodies[b].body.slot[i] {
-                            NOT_CANDIDATE => missing.push((b, node)),
-                            s => entries.push((b, s, w * n[k])),
+            let row = |direction: &Vector3<Real>, missing: &mut Vec<(usize, usize)>| {
+                let mut entries = Vec::with_capacity(12);
+                for &(b, node, w) in &e.nodes {
+                    let dofs = &parts[b].dofs;
+                    for k in 0..dofs.dofs_per_node {
+                        if let Some(i) = dofs.free_index(node, k) {
+                            match self.bodies[b].body.slot[i] {
+                                NOT_CANDIDATE => missing.push((b, node)),
+                                s => entries.push((b, s, w * direction[k])),
+                            }
                         }
                     }
                 }
+                entries
+            };
+            let (Some(stiffness), Some(_)) = (e.stiffness(), &e.tangential) else {
+                let entries = row(&n, &mut missing);
+                if !entries.is_empty() && e.penalty.stiffness > 0.0 {
+                    rows.push(ContactRow {
+                        penalty: e.penalty.stiffness,
+                        entries,
+                        coupling: Vec::new(),
+                    });
+                }
+                continue;
+            };
+            // With friction: a row along the normal and one along each tangent direction,
+            // coupled by the contact's stiffness in that basis.
+            let mut k3 = stiffness;
+            if let Some((a, b)) = e.rank_one() {
+                k3 += a * b.transpose();
             }
-            if !entries.is_empty() && e.penalty.stiffness > 0.0 {
+            let axes = contact_axes(&n, parts[e.contact.body].dofs.dofs_per_node);
+            let first = rows.len();
+            let mut added = Vec::with_capacity(axes.len());
+            for axis in &axes {
+                added.push(row(axis, &mut missing));
+            }
+            if added.iter().all(|r| r.is_empty()) {
+                continue;
+            }
+            for (i, (entries, ei)) in added.into_iter().zip(&axes).enumerate() {
+                let coupling = axes
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, _)| j != i)
+                    .map(|(j, ej)| (first + j, ei.dot(&(k3 * ej))))
+                    .collect();
                 rows.push(ContactRow {
-                    penalty: e.penalty.stiffness,
+                    penalty: ei.dot(&(k3 * ei)),
                     entries,
+                    coupling,
                 });
             }
         }
@@ -616,4 +652,23 @@ fn add_seconds(times: &mut PhaseTimes, c: &CondensedBody) {
     times.symbolic += c.seconds[0];
     times.numeric += c.seconds[1];
     times.solve += c.seconds[2];
+}
+
+/// The directions of a friction contact's rows: its normal `n`, then an orthonormal basis of
+/// the tangent plane (one direction in 2D, `d` = 2 DOFs per node; two in 3D).
+fn contact_axes(n: &Vector3<Real>, d: usize) -> Vec<Vector3<Real>> {
+    if d < 3 {
+        return vec![*n, Vector3::new(-n.y, n.x, 0.0)];
+    }
+    // The coordinate axis least along n starts the tangent basis.
+    let (mut least, mut axis) = (Real::INFINITY, 0);
+    for k in 0..3 {
+        if n[k].abs() < least {
+            least = n[k].abs();
+            axis = k;
+        }
+    }
+    let t1 = (Vector3::ith(axis, 1.0) - n * n[axis]).normalize();
+    let t2 = n.cross(&t1);
+    vec![*n, t1, t2]
 }
