@@ -17,8 +17,8 @@ pub enum Ran {
     Solved {
         /// The world it ran.
         world: Box<World>,
-        /// Its summary.
-        summary: Summary,
+        /// Its summary (boxed: it is large beside the other variants).
+        summary: Box<Summary>,
         /// Wall time of building and running it, s.
         seconds: f64,
     },
@@ -97,7 +97,7 @@ pub fn run_job(
             (
                 Ran::Solved {
                     world: Box::new(world),
-                    summary,
+                    summary: Box::new(summary),
                     seconds,
                 },
                 row,
