@@ -298,7 +298,7 @@ mod tests {
         for dg in [
             Vector3::new(1e-6, 0.0, 0.0),   // stick
             Vector3::new(4e-5, 1e-5, 0.0),  // slip
-            Vector3::new(-3e-5, 0.0, 2e-5), // slip the other way
+            Vector3::new(-3e-5, 0.0, 2e-6), // slip the other way
         ] {
             let at = force(&dg);
             let mut k = at.stiffness;
@@ -312,7 +312,7 @@ mod tests {
                 let numeric = -(force(&(dg + e)).force - force(&(dg - e)).force) / (2.0 * h);
                 let scale = k.norm();
                 assert!(
-                    (numeric - k.column(j)).norm() < 1e-5 * scale,
+                    (numeric - k.column(j)).norm() <= 1e-5 * scale,
                     "{:?}: column {j}: {numeric} against {}",
                     at.state,
                     k.column(j)

@@ -51,12 +51,20 @@ pub fn job_row(job: &Job, status: String, results: Option<&Path>, world: Option<
         .map(|b| b.members)
         .sum::<usize>()
         .to_string();
+    if let Some(c) = &summary.collapse {
+        // A collapse is a result, not a failure: the status says where.
+        row.status = format!(
+            "collapsed: body '{}' at step {} (load factor {}), member {}",
+            c.body, c.step, c.load_factor, c.member
+        );
+    }
     let seconds: Real = summary.steps.iter().map(|s| s.seconds).sum();
     row.seconds = format!("{seconds:.6}");
     if let Some(last) = summary.steps.last() {
         row.steps = last.step.to_string();
         row.max_displacement = format!("{:e}", last.max_displacement);
         row.overloaded = last.overloaded.to_string();
+        row.broken = last.broken.map(|b| b.to_string()).unwrap_or_default();
         for pair in &last.contact_forces {
             for (axis, f) in pair.force.iter().enumerate() {
                 row.contact.push((
