@@ -383,3 +383,38 @@ displacement = [0.0002, 0.0]
     assert_eq!(one.1, two.1);
     assert_eq!(one.2, two.2);
 }
+
+#[test]
+fn a_collapse_is_a_result_in_the_batch_table_with_the_members_broken() {
+    let out = tempfile::tempdir().unwrap();
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper_fracture.toml");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_linkage"))
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(out.path())
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let table = std::fs::read_to_string(out.path().join("batch.csv")).unwrap();
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let row = lines.next().unwrap();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    // The status holds commas inside quotes: the broken column is read from the end.
+    assert!(row.contains("\"collapsed: body 'solid' at step 3"), "{row}");
+    let summary: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(out.path().join("paper_fracture/summary.json")).unwrap(),
+    )
+    .unwrap();
+    let broken_last = summary["steps"].as_array().unwrap().last().unwrap()["broken"].clone();
+    assert!(column("broken") > column("status"));
+    assert!(
+        row.contains(&format!(",{broken_last},")),
+        "{row} should hold broken = {broken_last}"
+    );
+}

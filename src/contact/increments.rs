@@ -139,6 +139,32 @@ impl ContactSolver {
         Ok(reported)
     }
 
+    /// The problem of the current state with `set`, `forces` (N per body DOF) and the obstacles
+    /// at `offsets` (m), for `step`: the contact Newton's limits and friction's history.
+    fn problem<'a>(
+        &'a self,
+        bodies: &'a [Body],
+        set: &'a ContactSet,
+        forces: &'a [Vec<Real>],
+        offsets: &'a [Vector3<Real>],
+        step: usize,
+    ) -> Problem<'a> {
+        let (tolerance, max_iterations) = newton_limits(bodies);
+        Problem {
+            bodies,
+            geometry: &self.geometry,
+            set,
+            forces,
+            offsets,
+            step,
+            tolerance,
+            max_iterations,
+            move_cap: self.move_cap,
+            force_floor: self.force_floor(),
+            friction: self.friction.as_ref(),
+        }
+    }
+
     /// The sliding of a body at `step` of `steps`, from the current state: a body whose
     /// applied loads at the step have a part along its contacts (perpendicular to the sum of
     /// their normal forces) beyond the `Σ μ f_N` they hold there. `None` when no body is.
@@ -156,20 +182,7 @@ impl ContactSolver {
         let found = self.look(bodies, &self.active.clone(), &offsets);
         let history = self.friction.as_ref()?;
         let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
-        let (tolerance, max_iterations) = newton_limits(bodies);
-        let problem = Problem {
-            bodies,
-            geometry: &self.geometry,
-            set: &found,
-            forces: &forces,
-            offsets: &offsets,
-            step,
-            tolerance,
-            max_iterations,
-            move_cap: self.move_cap,
-            force_floor: self.force_floor(),
-            friction: Some(history),
-        };
+        let problem = self.problem(bodies, &found, &forces, &offsets, step);
         let mut normals = self.normals.clone();
         let evaluated = problem.evaluate(&mut normals, &self.parts);
         // Per body: the mean direction its contacts press it along, and the largest μ among
@@ -230,20 +243,7 @@ impl ContactSolver {
         };
         let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
         let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
-        let (tolerance, max_iterations) = newton_limits(bodies);
-        let problem = Problem {
-            bodies,
-            geometry: &self.geometry,
-            set: &self.active,
-            forces: &forces,
-            offsets: &offsets,
-            step,
-            tolerance,
-            max_iterations,
-            move_cap: self.move_cap,
-            force_floor: self.force_floor(),
-            friction: Some(history),
-        };
+        let problem = self.problem(bodies, &self.active, &forces, &offsets, step);
         let mut normals = self.normals.clone();
         let evaluated = problem.evaluate(&mut normals, &self.parts);
         let mut committed = HashMap::new();
@@ -371,20 +371,7 @@ impl ContactSolver {
         offsets: &[Vector3<Real>],
         step: usize,
     ) -> Real {
-        let (tolerance, max_iterations) = newton_limits(bodies);
-        let problem = Problem {
-            bodies,
-            geometry: &self.geometry,
-            set: &self.active,
-            forces,
-            offsets,
-            step,
-            tolerance,
-            max_iterations,
-            move_cap: self.move_cap,
-            force_floor: self.force_floor(),
-            friction: self.friction.as_ref(),
-        };
+        let problem = self.problem(bodies, &self.active, forces, offsets, step);
         let mut normals = self.normals.clone();
         let evaluated = problem.evaluate(&mut normals, &self.parts);
         let (r, _) = self
