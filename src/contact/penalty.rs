@@ -1,7 +1,7 @@
 //! Penalty forces: a node that has crossed a surface is pushed back along the surface normal in
 //! proportion to its depth, and the penalty's stiffness goes into the Newton matrix.
 
-use crate::linkage::Body;
+use crate::linkage::{member_stiffnesses, Body};
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
 
@@ -18,15 +18,7 @@ pub fn default_penalty(body: &Body) -> Real {
     if body.members.is_empty() {
         return 0.0;
     }
-    let sum: Real = body
-        .members
-        .iter()
-        .enumerate()
-        .map(|(m, member)| {
-            let material = &body.materials[member.material];
-            material.youngs_modulus * material.area / body.member_length(m)
-        })
-        .sum();
+    let sum: Real = member_stiffnesses(body).iter().sum();
     PENALTY_FACTOR * sum / body.members.len() as Real
 }
 

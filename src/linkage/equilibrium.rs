@@ -8,7 +8,7 @@ use crate::linkage::load_patterns::{solve_load_patterns, LoadPattern};
 use crate::linkage::mechanism::{diagnose_mechanism, Mechanism};
 use crate::linkage::step_state::post_process;
 use crate::linkage::{
-    axial_stiffness, member_block, Body, BodyError, DofMap, SolverUsed, StepState,
+    member_block, member_stiffnesses, Body, BodyError, DofMap, SolverUsed, StepState,
     StiffnessAssembly,
 };
 use crate::Real;
@@ -151,14 +151,7 @@ impl Equilibrium {
         let t = Instant::now();
         let dofs = DofMap::new(body);
         let assembly = StiffnessAssembly::new(body, &dofs)?;
-        let stiffness: Vec<Real> = (0..body.members.len())
-            .map(|m| {
-                axial_stiffness(
-                    &body.materials[body.members[m].material],
-                    body.member_length(m),
-                )
-            })
-            .collect();
+        let stiffness = member_stiffnesses(body);
         let mut values = Vec::new();
         assembly.fill(
             body,

@@ -1,12 +1,24 @@
 //! The stiffness of one member (paper Eq. 1–2): `AE/L` and its block in global axes.
 
-use crate::linkage::{Dimension, Material};
+use crate::linkage::{Body, Dimension, Material};
 use crate::Real;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// Axial stiffness of a member, N/m: `k = A E / L` (paper Eq. 1 read as `F = k D`).
 pub fn axial_stiffness(material: &Material, length: Real) -> Real {
     material.area * material.youngs_modulus / length
+}
+
+/// The axial stiffness `A E / L` of every member of `body`, in member order, N/m.
+pub fn member_stiffnesses(body: &Body) -> Vec<Real> {
+    (0..body.members.len())
+        .map(|m| {
+            axial_stiffness(
+                &body.materials[body.members[m].material],
+                body.member_length(m),
+            )
+        })
+        .collect()
 }
 
 /// The 3×3 block `k n nᵀ` of a member from `a` to `b` (n the unit axis): the member matrix of

@@ -16,7 +16,9 @@ pub use self::material::{Behaviour, Failure, Material, Scatter};
 pub use self::mechanism::Mechanism;
 pub use self::member_check::check_members;
 pub use self::member_response::{member_response, MemberResponse};
-pub use self::member_stiffness::{axial_stiffness, member_block, member_stiffness_matrix};
+pub use self::member_stiffness::{
+    axial_stiffness, member_block, member_stiffness_matrix, member_stiffnesses,
+};
 pub use self::newton::NewtonEquilibrium;
 pub(crate) use self::newton::{lagrange_weights, IncrementSize};
 pub use self::pressure::pressure_loads;

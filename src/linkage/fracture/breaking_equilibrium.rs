@@ -20,7 +20,7 @@ use crate::linkage::load_patterns::{solve_load_patterns, LoadPattern};
 use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::step_state::{force_scale, free_out_of_balance};
 use crate::linkage::{
-    axial_stiffness, member_block, post_process, Body, Convergence, DofMap, DofSlot, PhaseTimes,
+    member_block, member_stiffnesses, post_process, Body, Convergence, DofMap, DofSlot, PhaseTimes,
     SolveError, StepState, StiffnessAssembly,
 };
 use crate::Real;
@@ -89,14 +89,7 @@ impl BreakingEquilibrium {
         let t = Instant::now();
         let dofs = DofMap::new(body);
         let assembly = StiffnessAssembly::new(body, &dofs)?;
-        let stiffness: Vec<Real> = (0..body.members.len())
-            .map(|m| {
-                axial_stiffness(
-                    &body.materials[body.members[m].material],
-                    body.member_length(m),
-                )
-            })
-            .collect();
+        let stiffness = member_stiffnesses(body);
         let axes = body
             .members
             .iter()
