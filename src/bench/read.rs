@@ -33,27 +33,50 @@ pub struct ReadTiming {
     pub patches_seconds: Real,
 }
 
-/// Write the files of a lattice of `cells` (0.01 m cells) into `dir`, then read them `repeats`
-/// times and keep each phase's best time.
-pub fn measure_read(cells: [usize; 3], dir: &Path, repeats: usize) -> Result<ReadTiming, String> {
+/// The paper's files of a box lattice written by [`write_lattice_files`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct LatticeFiles {
+    /// The nodes file.
+    pub nodes: std::path::PathBuf,
+    /// The links file (each line with the material column `steel`).
+    pub links: std::path::PathBuf,
+    /// The patches file.
+    pub patches: std::path::PathBuf,
+    /// Nodes, members and patches written.
+    pub counts: [usize; 3],
+}
+
+/// Write the paper's files of a box lattice of `cells` (0.01 m cells, from the origin) into
+/// `dir` as `lattice.nodes`, `lattice.links` (material `steel`) and `lattice.patches`.
+pub fn write_lattice_files(cells: [usize; 3], dir: &Path) -> Result<LatticeFiles, String> {
     let size = cells.map(|c| c as Real * 0.01);
     let g = box_lattice(size, cells).map_err(|e| e.to_string())?;
     let names = vec!["steel".to_string(); g.members.len()];
-    let (nodes_path, links_path, patches_path) = (
-        dir.join("lattice.nodes"),
-        dir.join("lattice.links"),
-        dir.join("lattice.patches"),
-    );
+    let files = LatticeFiles {
+        nodes: dir.join("lattice.nodes"),
+        links: dir.join("lattice.links"),
+        patches: dir.join("lattice.patches"),
+        counts: [g.nodes.len(), g.members.len(), g.patches.len()],
+    };
     let io = |e: std::io::Error| format!("{}: {e}", dir.display());
-    write_nodes(&nodes_path, g.dimension, &g.nodes).map_err(io)?;
-    write_links(&links_path, &g.members, Some(&names)).map_err(io)?;
-    write_patches(&patches_path, &g.patches).map_err(io)?;
+    write_nodes(&files.nodes, g.dimension, &g.nodes).map_err(io)?;
+    write_links(&files.links, &g.members, Some(&names)).map_err(io)?;
+    write_patches(&files.patches, &g.patches).map_err(io)?;
+    Ok(files)
+}
+
+/// Write the files of a lattice of `cells` (0.01 m cells) into `dir`, then read them `repeats`
+/// times and keep each phase's best time.
+pub fn measure_read(cells: [usize; 3], dir: &Path, repeats: usize) -> Result<ReadTiming, String> {
+    let files = write_lattice_files(cells, dir)?;
+    let (nodes_path, links_path, patches_path) = (&files.nodes, &files.links, &files.patches);
+    let io = |e: std::io::Error| format!("{}: {e}", dir.display());
     let mut t = ReadTiming {
         cells,
-        nodes: g.nodes.len(),
-        members: g.members.len(),
-        patches: g.patches.len(),
-        links_bytes: std::fs::metadata(&links_path).map_err(io)?.len(),
+        nodes: files.counts[0],
+        members: files.counts[1],
+        patches: files.counts[2],
+        links_bytes: std::fs::metadata(links_path).map_err(io)?.len(),
         nodes_seconds: Real::INFINITY,
         links_seconds: Real::INFINITY,
         check_seconds: Real::INFINITY,
@@ -61,16 +84,16 @@ pub fn measure_read(cells: [usize; 3], dir: &Path, repeats: usize) -> Result<Rea
     };
     for _ in 0..repeats.max(1) {
         let clock = Instant::now();
-        let (_, nodes) = read_nodes(&nodes_path).map_err(|e| e.to_string())?;
+        let (_, nodes) = read_nodes(nodes_path).map_err(|e| e.to_string())?;
         t.nodes_seconds = t.nodes_seconds.min(clock.elapsed().as_secs_f64());
         let clock = Instant::now();
-        let links = read_links(&links_path, &nodes).map_err(|e| e.to_string())?;
+        let links = read_links(links_path, &nodes).map_err(|e| e.to_string())?;
         t.links_seconds = t.links_seconds.min(clock.elapsed().as_secs_f64());
         let clock = Instant::now();
         check_members(&nodes, links.iter().map(|r| r.nodes)).map_err(|p| format!("{p:?}"))?;
         t.check_seconds = t.check_seconds.min(clock.elapsed().as_secs_f64());
         let clock = Instant::now();
-        read_patches(&patches_path, nodes.len()).map_err(|e| e.to_string())?;
+        read_patches(patches_path, nodes.len()).map_err(|e| e.to_string())?;
         t.patches_seconds = t.patches_seconds.min(clock.elapsed().as_secs_f64());
         if links.len() != t.members {
             return Err(format!(

@@ -64,7 +64,7 @@ impl BodySolver {
     /// Rows of `K_ff`.
     pub fn free_dofs(&self) -> usize {
         match self {
-            BodySolver::Linear(eq) => eq.assembly.n,
+            BodySolver::Linear(eq) => eq.free_dofs,
             BodySolver::Nonlinear(newton) => newton.assembly.n,
             BodySolver::Breaking(eq) => eq.assembly.n,
         }

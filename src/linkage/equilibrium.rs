@@ -124,13 +124,16 @@ pub enum SolveError {
 
 /// The linear equilibrium of one body (paper Eq. 5–10): `K_ff` assembled and factored once,
 /// one solve per distinct load schedule, every step a weighted sum of those solutions.
+///
+/// It keeps only the load patterns' solutions: the matrix and its factor are dropped once they
+/// are solved, so a large body holds no more than its results through the steps.
 pub struct Equilibrium {
     /// The free/support partition.
     pub dofs: DofMap,
-    /// The pattern of `K_ff` and the place of each member entry.
-    pub assembly: StiffnessAssembly,
-    /// Values of `K_ff` (lower triangle, in the assembly's pattern), N/m.
-    pub values: Vec<Real>,
+    /// Rows (and columns) of `K_ff`: the free DOFs.
+    pub free_dofs: usize,
+    /// Stored entries of the lower triangle of `K_ff`.
+    pub matrix_entries: usize,
     /// Time spent in each phase, s.
     pub times: PhaseTimes,
     /// Entries of the Cholesky factor (0 when nothing is free or solved iteratively).
@@ -144,31 +147,41 @@ pub struct Equilibrium {
     stiffness: Vec<Real>,
 }
 
+/// The pattern of `K_ff` of `body` and its values (lower triangle, N/m), paper Eq. 3–4.
+fn assemble(
+    body: &Body,
+    dofs: &DofMap,
+    stiffness: &[Real],
+) -> Result<(StiffnessAssembly, Vec<Real>), ModelTooLarge> {
+    let assembly = StiffnessAssembly::new(body, dofs)?;
+    let mut values = Vec::new();
+    assembly.fill(
+        body,
+        |m| {
+            let [a, b] = body.members[m].nodes;
+            member_block(&body.nodes[a], &body.nodes[b], stiffness[m])
+        },
+        &mut values,
+    );
+    Ok((assembly, values))
+}
+
 impl Equilibrium {
     /// Validate, assemble, factor and solve every load pattern of `body`.
     pub fn new(body: &Body) -> Result<Self, SolveError> {
         body.validate()?;
         let t = Instant::now();
         let dofs = DofMap::new(body);
-        let assembly = StiffnessAssembly::new(body, &dofs)?;
         let stiffness = member_stiffnesses(body);
-        let mut values = Vec::new();
-        assembly.fill(
-            body,
-            |m| {
-                let [a, b] = body.members[m].nodes;
-                member_block(&body.nodes[a], &body.nodes[b], stiffness[m])
-            },
-            &mut values,
-        );
+        let (mut assembly, mut values) = assemble(body, &dofs, &stiffness)?;
         let times = PhaseTimes {
             assembly: t.elapsed().as_secs_f64(),
             ..Default::default()
         };
         let mut eq = Equilibrium {
             dofs,
-            assembly,
-            values,
+            free_dofs: assembly.n,
+            matrix_entries: assembly.nnz(),
             times,
             factor_entries: 0,
             solver_used: SolverUsed::Direct,
@@ -177,15 +190,25 @@ impl Equilibrium {
             stiffness,
         };
         let mut fell_back = None;
-        if eq.assembly.n > 0
+        if eq.free_dofs > 0
             && body
                 .solver
-                .use_iterative(eq.dofs.dofs_per_node, eq.assembly.n)
+                .use_iterative(eq.dofs.dofs_per_node, eq.free_dofs)
         {
             let t = Instant::now();
-            let mut it =
-                IterativeSolver::new(&eq.assembly, &eq.dofs, &body.nodes, body.solver.iterative);
-            it.refill(&eq.values);
+            let mut it = IterativeSolver::with_values(
+                &assembly,
+                &values,
+                &eq.dofs,
+                &body.nodes,
+                body.solver.iterative,
+            );
+            // The solver holds K_ff in full rows now. The lower triangle and the members'
+            // places in it would stay resident through the whole solve (a quarter of the
+            // memory of a large body) for a fallback that is rare: release them, and assemble
+            // again if conjugate gradients fail.
+            drop(assembly);
+            drop(values);
             eq.times.symbolic = t.elapsed().as_secs_f64();
             let t = Instant::now();
             let mut failure = None;
@@ -206,8 +229,11 @@ impl Equilibrium {
                     }
                 }
             });
-            eq.times.solve = t.elapsed().as_secs_f64();
+            // The multigrid set-up is set-up, as a direct solver's analysis is.
+            eq.times.symbolic += it.setup_seconds;
+            eq.times.solve = t.elapsed().as_secs_f64() - it.setup_seconds;
             eq.linear_iterations = it.iterations;
+            drop(it);
             if let Some(patterns) = patterns {
                 eq.patterns = patterns;
                 eq.solver_used = SolverUsed::Iterative;
@@ -216,11 +242,14 @@ impl Equilibrium {
             // Conjugate gradients failed: the direct solver decides (and names a mechanism).
             fell_back = failure;
             eq.solver_used = SolverUsed::IterativeThenDirect;
+            let t = Instant::now();
+            (assembly, values) = assemble(body, &eq.dofs, &eq.stiffness)?;
+            eq.times.assembly += t.elapsed().as_secs_f64();
         }
         let mut cholesky = None;
-        if eq.assembly.n > 0 {
+        if eq.free_dofs > 0 {
             let t = Instant::now();
-            let a = &eq.assembly;
+            let a = &assembly;
             let mut c = SparseCholesky::analyze(a.n, &a.col_ptr, &a.row_idx, Some(&a.groups))
                 .map_err(|e| eq.factorization_error(body, e))?;
             eq.times.symbolic += t.elapsed().as_secs_f64();
@@ -240,8 +269,8 @@ impl Equilibrium {
                 }
             }
             let t = Instant::now();
-            if let Err(e) = c.factorize(&eq.values) {
-                return Err(eq.singular(body, &mut c, e));
+            if let Err(e) = c.factorize(&values) {
+                return Err(eq.singular(body, &assembly, &values, &mut c, e));
             }
             eq.times.numeric = t.elapsed().as_secs_f64();
             eq.factor_entries = c.stats().nnz_l;
@@ -267,19 +296,21 @@ impl Equilibrium {
     }
 
     /// Turn a failed factorization into a mechanism report naming nodes and directions.
-    fn singular(&self, body: &Body, c: &mut SparseCholesky, e: CholeskyError) -> SolveError {
+    fn singular(
+        &self,
+        body: &Body,
+        assembly: &StiffnessAssembly,
+        values: &[Real],
+        c: &mut SparseCholesky,
+        e: CholeskyError,
+    ) -> SolveError {
         let pivot = match e {
             CholeskyError::NonPositivePivot { dof } => dof,
             CholeskyError::NearlySingular { dof, .. } => dof,
             other => return self.factorization_error(body, other),
         };
         SolveError::Mechanism(Box::new(diagnose_mechanism(
-            body,
-            &self.dofs,
-            &self.assembly,
-            &self.values,
-            c,
-            pivot,
+            body, &self.dofs, assembly, values, c, pivot,
         )))
     }
 
@@ -289,7 +320,7 @@ impl Equilibrium {
         body: &Body,
         solve: &mut dyn FnMut(&mut [Real]) -> bool,
     ) -> Option<Vec<LoadPattern>> {
-        solve_load_patterns(body, &self.dofs, self.assembly.n, &self.stiffness, solve)
+        solve_load_patterns(body, &self.dofs, self.free_dofs, &self.stiffness, solve)
     }
 
     /// The state at `step` of `steps` (step 0: undeformed, unloaded).

@@ -32,6 +32,8 @@ pub(crate) struct IterativeSolver {
     history: std::collections::VecDeque<Vec<Real>>,
     /// Conjugate-gradient iterations, all solves.
     pub iterations: usize,
+    /// Wall time of building multigrid hierarchies, all solves, s.
+    pub setup_seconds: Real,
 }
 
 impl IterativeSolver {
@@ -42,8 +44,19 @@ impl IterativeSolver {
         nodes: &[Vector3<Real>],
         settings: IterativeSettings,
     ) -> Self {
+        let matrix = SymmetricCsr::from_lower(assembly.n, &assembly.col_ptr, &assembly.row_idx);
+        Self::with_matrix(matrix, assembly, dofs, nodes, settings)
+    }
+
+    fn with_matrix(
+        matrix: SymmetricCsr,
+        assembly: &StiffnessAssembly,
+        dofs: &DofMap,
+        nodes: &[Vector3<Real>],
+        settings: IterativeSettings,
+    ) -> Self {
         IterativeSolver {
-            matrix: SymmetricCsr::from_lower(assembly.n, &assembly.col_ptr, &assembly.row_idx),
+            matrix,
             multigrid: None,
             groups: assembly.groups.clone(),
             near_null_space: rigid_body_rows(nodes, dofs),
@@ -52,7 +65,26 @@ impl IterativeSolver {
             stale: false,
             history: std::collections::VecDeque::new(),
             iterations: 0,
+            setup_seconds: 0.0,
         }
+    }
+
+    /// The iterative solver of a `K_ff` filled once (`lower_values` in the assembly's order):
+    /// it keeps no refill map, so [`Self::refill`] and [`Self::lower_values`] do not apply.
+    pub(crate) fn with_values(
+        assembly: &StiffnessAssembly,
+        lower_values: &[Real],
+        dofs: &DofMap,
+        nodes: &[Vector3<Real>],
+        settings: IterativeSettings,
+    ) -> Self {
+        let matrix = SymmetricCsr::from_lower_values(
+            assembly.n,
+            &assembly.col_ptr,
+            &assembly.row_idx,
+            lower_values,
+        );
+        Self::with_matrix(matrix, assembly, dofs, nodes, settings)
     }
 
     /// New values of `K_ff` (lower triangle in the assembly's order). The hierarchy is kept: it
@@ -63,6 +95,7 @@ impl IterativeSolver {
     }
 
     fn rebuild(&mut self) -> Result<(), MultigridError> {
+        let started = std::time::Instant::now();
         self.multigrid = None;
         self.multigrid = Some(SmoothedAggregation::new(
             &self.matrix,
@@ -71,6 +104,7 @@ impl IterativeSolver {
         )?);
         self.fresh_iterations = None;
         self.stale = false;
+        self.setup_seconds += started.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -186,7 +220,8 @@ impl IterativeSolver {
         }
     }
 
-    /// The current lower-triangle values (for a fallback to the direct solver).
+    /// The current lower-triangle values (for a fallback to the direct solver); only for a
+    /// solver made by [`Self::new`], which keeps the refill map.
     pub(crate) fn lower_values(&self, assembly: &StiffnessAssembly) -> Vec<Real> {
         self.matrix.lower_values(assembly.nnz())
     }

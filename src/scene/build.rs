@@ -125,6 +125,7 @@ pub fn load_scene(path: &Path) -> Result<World, SceneError> {
 /// Parse and check scene `text` that was read from `path` (relative file names resolve
 /// against its folder).
 pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
+    let started = std::time::Instant::now();
     let spec: SceneSpec = toml::from_str(text).map_err(|e| SceneError::Parse {
         path: path.to_path_buf(),
         message: e.to_string().trim_end().to_string(),
@@ -278,6 +279,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         source: path.to_path_buf(),
         scene_digest: crate::scene::scene_digest(text),
         prepared,
+        build_seconds: started.elapsed().as_secs_f64(),
     })
 }
 
@@ -585,6 +587,7 @@ fn build_body(
             )));
         }
         let links = paper_files::read_links(&links_path, &nodes).map_err(in_file("links"))?;
+        body.members.reserve_exact(links.len());
         for link in &links {
             let material = match &link.material {
                 Some(name) => material_index(name).ok_or_else(|| {

@@ -92,7 +92,10 @@ fn run_in(
         scene: world.name.clone(),
         steps: Vec::with_capacity(world.steps + 1),
         bodies: simulation.sizes(),
-        phases: PhaseSeconds::default(),
+        phases: PhaseSeconds {
+            reading: world.build_seconds,
+            ..Default::default()
+        },
         failure: None,
         scene_digest: world.scene_digest.clone(),
         prepared: world.prepared.clone(),

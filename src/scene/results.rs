@@ -220,13 +220,17 @@ pub struct BodySize {
 /// Wall time of the run's phases, s, summed over bodies.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PhaseSeconds {
+    /// Reading the scene and its files, building (generating, preparing) its bodies.
+    #[serde(default)]
+    pub reading: Real,
     /// Assembly of `K_ff`.
     pub assembly: Real,
-    /// Ordering and symbolic factorization.
+    /// Ordering and symbolic factorization (linear iterative bodies: the matrix in full rows
+    /// and the multigrid set-up).
     pub symbolic: Real,
     /// Numeric factorization.
     pub numeric: Real,
-    /// Triangular solves.
+    /// Triangular solves (iterative bodies: conjugate gradients).
     pub solve: Real,
     /// Writing result files.
     pub writing: Real,

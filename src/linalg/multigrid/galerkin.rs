@@ -8,9 +8,10 @@ use crate::linalg::block_matrix::{BlockMatrix, BLOCK_ROWS_PER_TASK};
 use crate::linalg::SymmetricCsr;
 use crate::Real;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// `A P` for the block copy `a` (block rows of `W` rows), in chunks of `W · BLOCK_ROWS_PER_TASK`
-/// rows; each row of `A P` is then scaled by `scale(row)` and, when `add` is given, the row
+/// rows, for the chunks `chunks` only (all: `0..block_chunks(a)`); each row of `A P` is then scaled by `scale(row)` and, when `add` is given, the row
 /// of `add` is added. With the rows of one block sharing their pattern in `p` (true of the
 /// tentative prolongator and of every product of this function), one aggregate lookup serves
 /// a whole `W×W` block times `W×MODES` values.
@@ -20,8 +21,9 @@ pub(super) fn block_product<const W: usize>(
     count: usize,
     scale: impl Fn(usize) -> Real + Sync,
     add: Option<&AggregateRows>,
+    chunks: Range<usize>,
 ) -> Vec<RowChunk> {
-    (0..a.blocks.div_ceil(BLOCK_ROWS_PER_TASK))
+    chunks
         .into_par_iter()
         .map(|chunk| {
             let mut place = vec![u32::MAX; count];
@@ -87,14 +89,29 @@ pub(super) fn block_product<const W: usize>(
                 touched.clear();
                 sums.clear();
             }
+            // Grown by doubling: the slack would outlive the chunk in the band held.
+            out.0.shrink_to_fit();
+            out.1.shrink_to_fit();
+            out.2.shrink_to_fit();
             out
         })
         .collect()
 }
 
-/// `A P` row by row, per aggregate, in chunks of `ROWS_PER_TASK` rows.
-pub(super) fn product_by_rows(a: &SymmetricCsr, p: &AggregateRows, count: usize) -> Vec<RowChunk> {
-    (0..a.n.div_ceil(ROWS_PER_TASK))
+/// The chunks of [`block_product`] for `a`.
+pub(super) fn block_chunks<const W: usize>(a: &BlockMatrix<W>) -> usize {
+    a.blocks.div_ceil(BLOCK_ROWS_PER_TASK)
+}
+
+/// `A P` row by row, per aggregate, in chunks of `ROWS_PER_TASK` rows, for the chunks `chunks`
+/// only (all: `0..a.n.div_ceil(ROWS_PER_TASK)`).
+pub(super) fn product_by_rows(
+    a: &SymmetricCsr,
+    p: &AggregateRows,
+    count: usize,
+    chunks: Range<usize>,
+) -> Vec<RowChunk> {
+    chunks
         .into_par_iter()
         .map(|chunk| {
             let mut acc = RowAccumulator::new(count);
@@ -108,23 +125,104 @@ pub(super) fn product_by_rows(a: &SymmetricCsr, p: &AggregateRows, count: usize)
                 }
                 acc.finish(&mut out);
             }
+            // Grown by doubling: the slack would outlive the chunk in the band held.
+            out.0.shrink_to_fit();
+            out.1.shrink_to_fit();
+            out.2.shrink_to_fit();
             out
         })
         .collect()
 }
 
-/// The Galerkin coarse matrix `PᵀAP`, as full rows, from `ap` = `A P` in chunks of
-/// `rows_per_chunk` rows, whose rows come in blocks of `width` rows sharing their pattern
-/// in `P` and in `A P` (kept in its chunks: joining them would hold `A P` twice at the peak
-/// of the set-up).
+/// `A P` for the chunks of rows given (see [`block_product`], [`product_by_rows`]).
+pub(super) type ProductChunks<'a> = dyn Fn(Range<usize>) -> Vec<RowChunk> + Sync + 'a;
+
+/// Fine rows of `A` per band of the Galerkin product (see [`galerkin`]): a seventh of `A P` of
+/// a 367,500-DOF lattice at a time keeps its set-up near the solve's own memory.
+pub(super) const ROWS_PER_BAND: usize = 50_000;
+
+/// The Galerkin coarse matrix `PᵀAP`, as full rows. `A P` (`product`, in chunks of
+/// `rows_per_chunk` rows, `chunk_count` in all, rows in blocks of `width` rows sharing their
+/// pattern in `P` and in `A P`) is the largest array of the set-up, several times the coarse
+/// matrix: for a large `A` it is formed in up to 8 bands of about `rows_per_band` fine rows,
+/// for the coarse rows of one band at a time and only the fine rows they need, and dropped
+/// before the next. Each coarse row is summed in the same order whatever the bands, so the
+/// result does not depend on them.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn galerkin(
-    ap: Vec<RowChunk>,
+    product: &ProductChunks,
+    chunk_count: usize,
     rows_per_chunk: usize,
     width: usize,
     p: &AggregateRows,
     transpose: &(Vec<usize>, Vec<(u32, u32)>),
     numbering: &CoarseNumbering,
+    rows_per_band: usize,
 ) -> SymmetricCsr {
+    let count = numbering.rank.len();
+    let fine_rows = p.rows();
+    let bands = (fine_rows / rows_per_band.max(1))
+        .clamp(1, 8)
+        .min(count.max(1));
+    let (start, pairs) = transpose;
+    let mut rows = Vec::new();
+    for band in 0..bands {
+        let coarse = band * count / bands..(band + 1) * count / bands;
+        // The fine rows these coarse rows touch (each aggregate's pairs ascend by row).
+        let touched = coarse
+            .clone()
+            .filter(|&g| start[g] < start[g + 1])
+            .map(|g| {
+                (
+                    pairs[start[g]].0 as usize,
+                    pairs[start[g + 1] - 1].0 as usize,
+                )
+            });
+        let Some((low, high)) = touched.reduce(|(a, b), (c, d)| (a.min(c), b.max(d))) else {
+            continue;
+        };
+        let chunks = low / rows_per_chunk..(high / rows_per_chunk + 1).min(chunk_count);
+        let ap = product(chunks.clone());
+        rows.extend(galerkin_rows(
+            &ap,
+            chunks.start,
+            coarse,
+            rows_per_chunk,
+            width,
+            p,
+            transpose,
+            numbering,
+        ));
+    }
+    let n: usize = numbering.rank.iter().sum();
+    let nnz: usize = rows.iter().map(|c| c.1.len()).sum();
+    let mut row_ptr = Vec::with_capacity(n + 1);
+    row_ptr.push(0);
+    let mut col = Vec::with_capacity(nnz);
+    let mut val = Vec::with_capacity(nnz);
+    for (lengths, c, v) in rows {
+        for l in lengths {
+            row_ptr.push(row_ptr[row_ptr.len() - 1] + l);
+        }
+        col.extend(c);
+        val.extend(v);
+    }
+    SymmetricCsr::from_rows(n, row_ptr, col, val)
+}
+
+/// The full rows `coarse` of `PᵀAP`, from `ap` = the chunks of `A P` from `first_chunk` on
+/// (each `rows_per_chunk` rows), in tasks of consecutive coarse rows.
+#[allow(clippy::too_many_arguments)]
+fn galerkin_rows(
+    ap: &[RowChunk],
+    first_chunk: usize,
+    coarse: Range<usize>,
+    rows_per_chunk: usize,
+    width: usize,
+    p: &AggregateRows,
+    transpose: &(Vec<usize>, Vec<(u32, u32)>),
+    numbering: &CoarseNumbering,
+) -> Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> {
     let count = numbering.rank.len();
     // Where each row of AP starts in its chunk.
     let ap_starts: Vec<Vec<usize>> = ap
@@ -141,22 +239,27 @@ pub(super) fn galerkin(
     // Block row g of PᵀAP = Σ over fine rows i touching g of P[i, g]ᵀ · AP[i, :].
     let (start, pairs) = transpose;
     const GROUPS_PER_TASK: usize = 64;
-    let rows: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = (0..count.div_ceil(GROUPS_PER_TASK))
+    coarse
+        .clone()
+        .step_by(GROUPS_PER_TASK)
+        .collect::<Vec<_>>()
         .into_par_iter()
-        .map(|chunk| {
+        .map(|task_first| {
             let mut place = vec![u32::MAX; count];
             let mut touched: Vec<u32> = Vec::new();
             let mut blocks: Vec<[[Real; MODES]; MODES]> = Vec::new();
             let mut out = (Vec::new(), Vec::new(), Vec::new());
-            for g in chunk * GROUPS_PER_TASK..((chunk + 1) * GROUPS_PER_TASK).min(count) {
+            for g in task_first..(task_first + GROUPS_PER_TASK).min(coarse.end) {
                 // The rows of one block, consecutive here, share their pattern in AP.
                 for group in pairs[start[g]..start[g + 1]].chunks(width) {
                     // Per row of the group: its chunk of AP, where its row starts there, and
                     // its entry of P.
                     let mut rows = [(0usize, 0usize, 0usize); MODES];
                     for (slot, &(i, e)) in rows.iter_mut().zip(group) {
-                        let (chunk, local) =
-                            (i as usize / rows_per_chunk, i as usize % rows_per_chunk);
+                        let (chunk, local) = (
+                            i as usize / rows_per_chunk - first_chunk,
+                            i as usize % rows_per_chunk,
+                        );
                         *slot = (chunk, ap_starts[chunk][local], e as usize);
                     }
                     let rows = &rows[..group.len()];
@@ -205,23 +308,11 @@ pub(super) fn galerkin(
                 touched.clear();
                 blocks.clear();
             }
+            // Grown by doubling: the slack would outlive the chunk in the band held.
+            out.0.shrink_to_fit();
+            out.1.shrink_to_fit();
+            out.2.shrink_to_fit();
             out
         })
-        .collect();
-    drop(ap);
-    drop(ap_starts);
-    let n: usize = numbering.rank.iter().sum();
-    let nnz: usize = rows.iter().map(|c| c.1.len()).sum();
-    let mut row_ptr = Vec::with_capacity(n + 1);
-    row_ptr.push(0);
-    let mut col = Vec::with_capacity(nnz);
-    let mut val = Vec::with_capacity(nnz);
-    for (lengths, c, v) in rows {
-        for l in lengths {
-            row_ptr.push(row_ptr[row_ptr.len() - 1] + l);
-        }
-        col.extend(c);
-        val.extend(v);
-    }
-    SymmetricCsr::from_rows(n, row_ptr, col, val)
+        .collect()
 }

@@ -2,7 +2,7 @@
 //! its smoothing, the Galerkin levels, and the factored coarsest level.
 
 use super::cycle::{Level, Work};
-use super::galerkin::{block_product, galerkin, product_by_rows};
+use super::galerkin::{block_chunks, block_product, galerkin, product_by_rows, ROWS_PER_BAND};
 use super::smoother::{largest_eigenvalue, SmootherMatrix};
 use super::transfer::{
     by_aggregate, concatenate, AggregateRows, CoarseNumbering, RowAccumulator, Transfer, MODES,
@@ -63,6 +63,19 @@ impl SmoothedAggregation {
         near_null_space: &[[Real; MODES]],
         coarse_size: usize,
     ) -> Result<Self, MultigridError> {
+        Self::with_band_rows(matrix, groups, near_null_space, coarse_size, ROWS_PER_BAND)
+    }
+
+    /// As [`SmoothedAggregation::with_coarse_size`], forming each Galerkin product in bands of
+    /// about `rows_per_band` fine rows: less memory, a little repeated work at the bands'
+    /// edges, the same hierarchy to the last bit.
+    pub fn with_band_rows(
+        matrix: &SymmetricCsr,
+        groups: &[usize],
+        near_null_space: &[[Real; MODES]],
+        coarse_size: usize,
+        rows_per_band: usize,
+    ) -> Result<Self, MultigridError> {
         debug_assert_eq!(
             near_null_space.len(),
             matrix.n,
@@ -122,6 +135,7 @@ impl SmoothedAggregation {
                     count,
                     |i| -omega * inverse_diagonal[i],
                     Some(&tentative),
+                    0..block_chunks(m),
                 )),
                 SmootherMatrix::Blocks6(m) => concatenate(block_product(
                     m,
@@ -129,32 +143,45 @@ impl SmoothedAggregation {
                     count,
                     |i| -omega * inverse_diagonal[i],
                     Some(&tentative),
+                    0..block_chunks(m),
                 )),
                 _ => smooth_prolongator(a, &inverse_diagonal, omega, &tentative, count),
             };
             drop(tentative);
             let transpose = by_aggregate(&prolongator, count);
-            let (ap, ap_rows_per_chunk, width) = match &smoother {
-                SmootherMatrix::Blocks3(m) => (
-                    block_product(m, &prolongator, count, |_| 1.0, None),
+            let p = &prolongator;
+            let coarse = match &smoother {
+                SmootherMatrix::Blocks3(m) => galerkin(
+                    &|chunks| block_product(m, p, count, |_| 1.0, None, chunks),
+                    block_chunks(m),
                     3 * BLOCK_ROWS_PER_TASK,
                     3,
+                    p,
+                    &transpose,
+                    &numbering,
+                    rows_per_band,
                 ),
-                SmootherMatrix::Blocks6(m) => (
-                    block_product(m, &prolongator, count, |_| 1.0, None),
+                SmootherMatrix::Blocks6(m) => galerkin(
+                    &|chunks| block_product(m, p, count, |_| 1.0, None, chunks),
+                    block_chunks(m),
                     6 * BLOCK_ROWS_PER_TASK,
                     6,
+                    p,
+                    &transpose,
+                    &numbering,
+                    rows_per_band,
                 ),
-                _ => (product_by_rows(a, &prolongator, count), ROWS_PER_TASK, 1),
+                _ => galerkin(
+                    &|chunks| product_by_rows(a, p, count, chunks),
+                    a.n.div_ceil(ROWS_PER_TASK),
+                    ROWS_PER_TASK,
+                    1,
+                    p,
+                    &transpose,
+                    &numbering,
+                    rows_per_band,
+                ),
             };
-            let coarse = galerkin(
-                ap,
-                ap_rows_per_chunk,
-                width,
-                &prolongator,
-                &transpose,
-                &numbering,
-            );
             sizes.push(coarse.n);
             let mut coarse_blocks = numbering.offset.clone();
             coarse_blocks.push(coarse.n);
