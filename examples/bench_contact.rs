@@ -1,4 +1,5 @@
-//! Contact benchmark (issue 5): `cargo run --release --example bench_contact [--skip-pair]`.
+//! Contact benchmark (issues 5 and 13):
+//! `cargo run --release --example bench_contact [--skip-pair] [--friction] [--cells N]`.
 //!
 //! 1. Contact query time: one query iteration against a deformable surface of about 10,000 and
 //!    100,000 surface nodes: the oriented `TriMesh` rebuilt from the nodes, then every node of a
@@ -9,6 +10,10 @@
 //!    and the equilibrium residual. Both bodies ask for the direct solver: above 30,000 free
 //!    DOFs `auto` would pick conjugate gradients on the coupled system, and only bodies with a
 //!    factorization are condensed.
+//! 3. With `--friction` (the query timings are then left out): the same pair with μ = 0
+//!    (frictionless) and then with Coulomb friction μ = 0.3, the upper box sheared 0.1 mm along x per step from step
+//!    2 by its two held lines; the same phase times per step, with the sticking and slipping
+//!    contacts. `--cells N` sets the boxes' cells per edge (default 27: 28³ = 21,952 nodes).
 
 use linkage::contact::PatchSurface;
 use linkage::linkage::{generators, Body, Material};
@@ -54,7 +59,9 @@ fn query(cells: usize) {
     );
 }
 
-fn pair(n: usize) {
+/// The pair of boxes with `n` cells per edge; with `Some(μ)` (0 for frictionless), sheared
+/// from step 2 with Coulomb coefficient μ; with `None`, pressed only, frictionless.
+fn pair(n: usize, friction: Option<f64>) {
     let h = 0.1;
     let scene = format!(
         r#"
@@ -78,17 +85,20 @@ solver = "direct"
 offset = [0.0, {h}, 0.0]
 [[bodies.supports]]
 on_line = {{ point = [0.0, {h}, 0.0], direction = [0.0, 1.0, 0.0] }}
-fix = ["x", "z"]
+fix = ["x", "z"]{shear}
 [[bodies.supports]]
 on_line = {{ point = [0.2, {h}, 0.2], direction = [0.0, 1.0, 0.0] }}
-fix = ["x", "z"]
+fix = ["x", "z"]{shear}
 [[bodies.loads]]
 on_plane = {{ point = [0.0, {top}, 0.0], normal = [0.0, 1.0, 0.0] }}
 total_force = [0.0, -500.0, 0.0]
 [contact]
+{law}
 "#,
         top = 2.0 * h,
-        steps = STEPS
+        steps = STEPS,
+        shear = if friction.is_some() { SHEAR } else { "" },
+        law = friction.map_or(String::new(), |mu| format!("friction = {mu}")),
     );
     let world = build_world(&scene, Path::new("bench_pair.toml")).expect("a valid scene");
     let t = Instant::now();
@@ -112,7 +122,8 @@ total_force = [0.0, -500.0, 0.0]
         .collect();
     let p0 = phases(&sim);
     println!(
-        "pair   2 × {} nodes ({} free DOFs), {} load steps of 500/{} N, {} (candidate nodes {:?}): set-up {:.2} s (ordering+symbolic {:.2} s, factorization and compliance {:.2} s, load-pattern solves {:.2} s)",
+        "pair{}   2 × {} nodes ({} free DOFs), {} load steps of 500/{} N, {} (candidate nodes {:?}): set-up {:.2} s (ordering+symbolic {:.2} s, factorization and compliance {:.2} s, load-pattern solves {:.2} s)",
+        friction.map_or(String::new(), |mu| format!(" μ = {mu}")),
         world.bodies[0].nodes.len(),
         sim.contact()
             .map(|c| c.free_dofs(0) + c.free_dofs(1))
@@ -138,7 +149,7 @@ total_force = [0.0, -500.0, 0.0]
             continue;
         }
         println!(
-            "       step {step}: {seconds:.2} s = factorization {:.2} s + ordering {:.2} s + solves {:.2} s + contact queries {:.3} s + residuals {:.2} s + rest; {} Newton, {} contact iterations, residual {:.1e}, max penetration {:.2e} m",
+            "       step {step}: {seconds:.2} s = factorization {:.2} s + ordering {:.2} s + solves {:.2} s + contact queries {:.3} s + residuals {:.2} s + rest; {} Newton, {} contact iterations, residual {:.1e}, max penetration {:.2e} m{}",
             d[2],
             d[1],
             d[3],
@@ -147,7 +158,12 @@ total_force = [0.0, -500.0, 0.0]
             summary.iterations,
             summary.contact_iterations,
             summary.residual,
-            summary.max_penetration
+            summary.max_penetration,
+            if friction.is_some() {
+                format!("; {} sticking, {} slipping", summary.sticking, summary.slipping)
+            } else {
+                String::new()
+            }
         );
     }
 }
@@ -155,12 +171,32 @@ total_force = [0.0, -500.0, 0.0]
 /// Load steps of the pair benchmark: the first includes the one-off factorizations.
 const STEPS: usize = 4;
 
+/// The held lines' shear with friction: 0.1 mm along x per step from step 2.
+const SHEAR: &str = "\ndisplacement = [1e-4, 0.0, 0.0]\nschedule = [0.0, 1.0, 2.0, 3.0]";
+
 fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let flag = |name: &str| args.iter().any(|a| a == name);
+    // 28 × 28 × 28 = 21,952 nodes per box.
+    let cells = match args.iter().position(|a| a == "--cells") {
+        Some(i) => match args.get(i + 1).and_then(|v| v.parse::<usize>().ok()) {
+            Some(c) if c > 0 => c,
+            _ => {
+                eprintln!("--cells takes a positive whole number of cells per edge");
+                std::process::exit(2);
+            }
+        },
+        None => 27,
+    };
+    if flag("--friction") {
+        pair(cells, Some(0.0));
+        pair(cells, Some(0.3));
+        return;
+    }
     // 2 (c + 1)² surface nodes: c = 70 gives 10,082; c = 223 gives 100,352.
     query(70);
     query(223);
-    if !std::env::args().any(|a| a == "--skip-pair") {
-        // 28 × 28 × 28 = 21,952 nodes per box.
-        pair(27);
+    if !flag("--skip-pair") {
+        pair(cells, None);
     }
 }

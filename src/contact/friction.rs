@@ -101,6 +101,9 @@ pub struct Tangential {
     pub rank_one: Option<(Vector3<Real>, Vector3<Real>)>,
     /// Slip this increment would add, m (zero while sticking).
     pub slip: Vector3<Real>,
+    /// The stick stiffness `k_t` the mapping was made with, N/m (the tangent of sticking is
+    /// `k_t P`).
+    pub stick_stiffness: Real,
 }
 
 /// The return mapping of one contact: friction coefficient `mu`, stick stiffness `kt` (N/m),
@@ -133,6 +136,7 @@ pub fn return_mapping(
             stiffness: p * kt,
             rank_one: None,
             slip: Vector3::zeros(),
+            stick_stiffness: kt,
         };
     }
     let t = trial / size;
@@ -143,6 +147,7 @@ pub fn return_mapping(
         stiffness: (p - t * t.transpose()) * (limit * kt / size),
         rank_one: pressing.then(|| (t * (mu * kn), *n)),
         slip: -t * ((size - limit) / kt),
+        stick_stiffness: kt,
     }
 }
 

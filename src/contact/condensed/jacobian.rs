@@ -3,46 +3,233 @@
 use crate::contact::condensed::CondensedBody;
 use crate::Real;
 use faer::linalg::solvers::Solve;
-use faer::{Mat, Side};
+use faer::{Accum, Mat, MatMut, Par, Side};
+use nalgebra::{Matrix3, Vector3};
+use std::collections::HashMap;
 
 /// One row of the condensed problem: an active contact's normal (or, with friction, one of
 /// its tangent directions): its stiffness (N/m) and its row of `G`, the relative motion along
 /// the direction per unit displacement, as (body, candidate slot, coefficient).
 pub(crate) struct ContactRow {
-    /// Stiffness of the row against its own motion, N/m (the penalty for a normal row).
+    /// Stiffness of the row against its own motion, N/m: the penalty of a normal row; with
+    /// friction, the stiffness while the contact sticks (`k_n` along its normal, `k_t` along
+    /// a tangent).
     pub penalty: Real,
     /// The row's nonzero entries, as (body, candidate slot, coefficient).
     pub entries: Vec<(usize, usize, Real)>,
-    /// Stiffness against the motion of other rows of the same contact (friction), as (row,
-    /// N/m): the contact's `κ` is then a block, unsymmetric while it slips.
-    pub coupling: Vec<(usize, Real)>,
+    /// With friction: the contact the row belongs to (`None`: a frictionless normal row).
+    pub friction: Option<FrictionRow>,
 }
 
-/// `κ⁻¹ + G C Gᵀ` factored, or, when some contact's `κ` is a block (friction), `I + κ G C Gᵀ`
-/// and `κ`: `apply` gives `(κ⁻¹ + G C Gᵀ)⁻¹ x = (I + κ G C Gᵀ)⁻¹ κ x` either way.
+/// A row of a contact with friction: the contact's rows, the row's direction and the
+/// contact's stiffness while it slips.
+#[derive(Clone, Copy)]
+pub(crate) struct FrictionRow {
+    /// The contact's first row (its rows are consecutive: the normal, then the tangents).
+    pub first: usize,
+    /// The contact's number of rows.
+    pub count: usize,
+    /// The row's direction (unit).
+    pub axis: Vector3<Real>,
+    /// While the contact slips, its stiffness `−∂f/∂g` (N/m, Cartesian, unsymmetric);
+    /// `None` while it sticks (then `k_n n nᵀ + k_t P`: the rows' penalties, uncoupled).
+    pub slipping: Option<Matrix3<Real>>,
+}
+
+/// `(κ⁻¹ + G C Gᵀ)⁻¹ x`, applied as `(I + κ G C Gᵀ)⁻¹ κ x` (κ may be singular while a
+/// contact slips): a Cholesky factor without friction, [`FrictionInverse`] with it.
 enum Inverse {
     Symmetric(faer::linalg::solvers::Llt<Real>),
-    General {
-        lu: faer::linalg::solvers::PartialPivLu<Real>,
-        kappa: Vec<Vec<(usize, Real)>>,
-    },
+    Friction(Box<FrictionInverse>),
 }
 
 impl Inverse {
-    fn solve_in_place(&self, mut x: faer::MatMut<'_, Real>) {
+    fn solve_in_place(&self, x: MatMut<'_, Real>) {
         match self {
             Inverse::Symmetric(llt) => llt.solve_in_place(x),
-            Inverse::General { lu, kappa } => {
-                let mut y = Mat::<Real>::zeros(x.nrows(), x.ncols());
-                for (i, row) in kappa.iter().enumerate() {
-                    for j in 0..x.ncols() {
-                        y[(i, j)] = row.iter().map(|&(c, k)| k * x[(c, j)]).sum();
-                    }
+            Inverse::Friction(f) => f.solve_in_place(x),
+        }
+    }
+}
+
+/// `(I + κ A)⁻¹ κ` for contacts with friction, `A = G C Gᵀ` and `κ` block-diagonal (one block
+/// per contact, over its normal and tangent rows).
+///
+/// A sticking contact's block is the diagonal `R` of its rows' penalties (`k_n`, `k_t`, `k_t`),
+/// so `F = A + R⁻¹` (symmetric positive definite) is factored once by Cholesky, of the size
+/// of the rows. A slipping contact's block `K` (unsymmetric) differs from `R`: its rows (the set
+/// `S`) are solved by a Schur complement. With `w = F y` the rows outside `S` give
+/// `w_T = x_T`; those in `S` give
+///
+/// `[(I − K R⁻¹) Z + K] w_S = K x_S − (I − K R⁻¹) y⁰_S`, `Z = (F⁻¹)_SS`, `y⁰ = F⁻¹ [x_T; 0]`,
+///
+/// and then `y = F⁻¹ w`. `Z = Xᵀ X` with `X = L⁻¹ E_S` (`F = L Lᵀ`), whose columns are kept:
+/// when contacts start or stop slipping only the new rows' columns and the small dense
+/// problem on `S` are formed again, not `F` (see [`ContactJacobian::restiffen`]).
+struct FrictionInverse {
+    llt: faer::linalg::solvers::Llt<Real>,
+    /// `R` per row, N/m.
+    reference: Vec<Real>,
+    /// The rows of slipping contacts, ascending.
+    slipping: Vec<usize>,
+    /// `K` on those rows: per row, (position in `slipping`, N/m).
+    kappa: Vec<Vec<(usize, Real)>>,
+    /// LU of `(I − K R⁻¹) Z + K` (`None` while nothing slips).
+    schur: Option<faer::linalg::solvers::PartialPivLu<Real>>,
+    /// Columns `L⁻¹ e_j` by row `j`, kept with the factor.
+    columns: HashMap<usize, Vec<Real>>,
+}
+
+/// Right-hand sides solved together when columns of `L⁻¹` are formed.
+const COLUMN_BLOCK: usize = 64;
+
+impl FrictionInverse {
+    /// Factor `F` (`f`, `A + R⁻¹` with `R` the rows' penalties) and take the rows' stiffnesses.
+    fn new(f: Mat<Real>, rows: &[ContactRow]) -> Result<Self, String> {
+        // The frictionless path finds `κ⁻¹ + G C Gᵀ` not positive definite where the
+        // candidates' compliance is not (then the coupled solve takes over): the same test
+        // here, with the stick stiffnesses.
+        let llt = f
+            .llt(Side::Lower)
+            .map_err(|e| format!("the contact matrix is not positive definite: {e:?}"))?;
+        let mut inverse = FrictionInverse {
+            llt,
+            reference: rows.iter().map(|r| r.penalty).collect(),
+            slipping: Vec::new(),
+            kappa: Vec::new(),
+            schur: None,
+            columns: HashMap::new(),
+        };
+        inverse.set_stiffness(rows);
+        Ok(inverse)
+    }
+
+    /// Take the slipping contacts' blocks of `rows` (turned into the rows' own axes) and form
+    /// the Schur complement on their rows.
+    fn set_stiffness(&mut self, rows: &[ContactRow]) {
+        let k = rows.len();
+        self.slipping = rows
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.friction.is_some_and(|f| f.slipping.is_some()))
+            .map(|(i, _)| i)
+            .collect();
+        let s = self.slipping.len();
+        let mut position = vec![usize::MAX; k];
+        for (p, &i) in self.slipping.iter().enumerate() {
+            position[i] = p;
+        }
+        self.kappa = self
+            .slipping
+            .iter()
+            .map(|&i| {
+                let Some(f) = rows[i].friction else {
+                    return Vec::new();
+                };
+                let k3 = f.slipping.unwrap_or_else(Matrix3::zeros);
+                (f.first..f.first + f.count)
+                    .filter_map(|j| {
+                        let other = rows[j].friction?;
+                        Some((position[j], f.axis.dot(&(k3 * other.axis))))
+                    })
+                    .collect()
+            })
+            .collect();
+        if s == 0 {
+            self.schur = None;
+            return;
+        }
+        // The columns of L⁻¹ not formed yet, in blocks from the first row of each (the
+        // forward solve of e_j is zero above j).
+        let l = self.llt.L();
+        let mut missing: Vec<usize> = self
+            .slipping
+            .iter()
+            .copied()
+            .filter(|j| !self.columns.contains_key(j))
+            .collect();
+        missing.sort_unstable();
+        for block in missing.chunks(COLUMN_BLOCK) {
+            let j0 = block[0];
+            let mut rhs = Mat::<Real>::zeros(k - j0, block.len());
+            for (q, &j) in block.iter().enumerate() {
+                rhs[(j - j0, q)] = 1.0;
+            }
+            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+                l.submatrix(j0, j0, k - j0, k - j0),
+                rhs.as_mut(),
+                Par::rayon(0),
+            );
+            for (q, &j) in block.iter().enumerate() {
+                let mut column = vec![0.0; k];
+                for i in j0..k {
+                    column[i] = rhs[(i - j0, q)];
                 }
-                lu.solve_in_place(y.as_mut());
-                x.copy_from(&y);
+                self.columns.insert(j, column);
             }
         }
+        let mut x = Mat::<Real>::zeros(k, s);
+        for (p, j) in self.slipping.iter().enumerate() {
+            if let Some(column) = self.columns.get(j) {
+                for (i, &v) in column.iter().enumerate() {
+                    x[(i, p)] = v;
+                }
+            }
+        }
+        let mut z = Mat::<Real>::zeros(s, s);
+        faer::linalg::matmul::matmul(
+            z.as_mut(),
+            Accum::Replace,
+            x.transpose(),
+            x.as_ref(),
+            1.0,
+            Par::rayon(0),
+        );
+        // (I − K R⁻¹) Z + K, K block-diagonal.
+        let mut schur = z.clone();
+        for (p, row) in self.kappa.iter().enumerate() {
+            for &(q, v) in row {
+                let c = v / self.reference[self.slipping[q]];
+                for j in 0..s {
+                    schur[(p, j)] -= c * z[(q, j)];
+                }
+                schur[(p, q)] += v;
+            }
+        }
+        self.schur = Some(schur.partial_piv_lu());
+    }
+
+    fn solve_in_place(&self, mut x: MatMut<'_, Real>) {
+        let mut y0 = x.to_owned();
+        for &j in &self.slipping {
+            for c in 0..y0.ncols() {
+                y0[(j, c)] = 0.0;
+            }
+        }
+        self.llt.solve_in_place(y0.as_mut());
+        let Some(schur) = &self.schur else {
+            x.copy_from(&y0);
+            return;
+        };
+        // K x_S − (I − K R⁻¹) y⁰_S.
+        let mut r = Mat::<Real>::zeros(self.slipping.len(), x.ncols());
+        for (p, row) in self.kappa.iter().enumerate() {
+            for c in 0..x.ncols() {
+                let mut v = -y0[(self.slipping[p], c)];
+                for &(q, kv) in row {
+                    let j = self.slipping[q];
+                    v += kv * (x[(j, c)] + y0[(j, c)] / self.reference[j]);
+                }
+                r[(p, c)] = v;
+            }
+        }
+        schur.solve_in_place(r.as_mut());
+        for (p, &j) in self.slipping.iter().enumerate() {
+            for c in 0..x.ncols() {
+                x[(j, c)] = r[(p, c)];
+            }
+        }
+        self.llt.solve_in_place(x);
     }
 }
 
@@ -63,7 +250,9 @@ pub(crate) struct Correction {
 /// for residuals `Φ₁` (contact force found minus assumed at each body's candidates, N) and
 /// `Φ₂` (out-of-balance of each body along its rigid motions, N): a dense problem of the size
 /// of the active contacts, factored once and reused while Newton converges with it (a modified
-/// Newton step when the contacts' normals and weights have moved a little). Rigid motions the
+/// Newton step when the contacts' normals and weights have moved a little; with friction, one
+/// row per contact direction and the contacts' states brought up to date, see
+/// [`ContactJacobian::restiffen`]). Rigid motions the
 /// contacts do not hold (an eigenvalue of `Bᵀ A⁻¹ B` below 1000 `stabilisation`, N/m) are moved
 /// by their out-of-balance over `stabilisation`, as the coupled solve does.
 pub(crate) struct ContactJacobian {
@@ -100,10 +289,16 @@ impl ContactJacobian {
                 }
             }
         }
-        let general = rows
-            .iter()
-            .any(|r| !r.coupling.is_empty() || r.penalty.is_nan() || r.penalty <= 0.0);
-        // A = κ⁻¹ + G W, column by column (W's columns are contiguous); G W alone with blocks.
+        let general = rows.iter().any(|r| r.friction.is_some());
+        if general
+            && rows
+                .iter()
+                .any(|r| !(r.penalty > 0.0 && r.penalty.is_finite()))
+        {
+            return Err("a contact row has no positive stiffness".into());
+        }
+        // A = κ⁻¹ + G W, column by column (W's columns are contiguous); with friction
+        // `F = R⁻¹ + G W`, the rows' stick stiffnesses.
         let mut a = Mat::<Real>::zeros(k, k);
         for e2 in 0..k {
             let columns: Vec<Option<&[Real]>> = w
@@ -123,9 +318,7 @@ impl ContactJacobian {
                 }
                 col[e1] += sum;
             }
-            if !general {
-                col[e2] += 1.0 / rows[e2].penalty;
-            }
+            col[e2] += 1.0 / rows[e2].penalty;
         }
         drop(w);
         // Symmetrize round-off before the factorization.
@@ -136,46 +329,8 @@ impl ContactJacobian {
                 a[(j, i)] = v;
             }
         }
-        if general {
-            // The frictionless path finds `κ⁻¹ + G C Gᵀ` not positive definite where the
-            // candidates' compliance is not (then the coupled solve takes over): with friction,
-            // the same test on the rows' own stiffnesses.
-            let largest = rows.iter().map(|r| r.penalty).fold(0.0, Real::max);
-            let mut test = a.clone();
-            for (i, row) in rows.iter().enumerate() {
-                test[(i, i)] += 1.0
-                    / if row.penalty > 0.0 {
-                        row.penalty
-                    } else {
-                        largest
-                    };
-            }
-            test.llt(Side::Lower)
-                .map_err(|e| format!("the contact matrix is not positive definite: {e:?}"))?;
-        }
         let llt = if general {
-            // κ per row: its own stiffness and those against the contact's other rows.
-            let kappa: Vec<Vec<(usize, Real)>> = rows
-                .iter()
-                .enumerate()
-                .map(|(i, r)| {
-                    std::iter::once((i, r.penalty))
-                        .chain(r.coupling.iter().copied())
-                        .filter(|&(_, v)| v != 0.0)
-                        .collect()
-                })
-                .collect();
-            // M = I + κ (G W).
-            let mut m = Mat::<Real>::identity(k, k);
-            for (i, row) in kappa.iter().enumerate() {
-                for j in 0..k {
-                    m[(i, j)] += row.iter().map(|&(c, v)| v * a[(c, j)]).sum::<Real>();
-                }
-            }
-            Inverse::General {
-                lu: m.partial_piv_lu(),
-                kappa,
-            }
+            Inverse::Friction(Box::new(FrictionInverse::new(a, &rows)?))
         } else {
             Inverse::Symmetric(
                 a.llt(Side::Lower)
@@ -188,17 +343,33 @@ impl ContactJacobian {
             first.push(r);
             r += b.modes.len();
         }
+        let mut jacobian = ContactJacobian {
+            rows,
+            llt,
+            b_psi: Mat::zeros(0, 0),
+            first,
+            eigen: None,
+            rigid_lu: None,
+            stabilisation,
+        };
+        jacobian.rigid(bodies, r);
+        Ok(jacobian)
+    }
+
+    /// `B`, `A⁻¹ B` and `Bᵀ A⁻¹ B` of the `r` rigid motions, with the factor as it is.
+    fn rigid(&mut self, bodies: &[&CondensedBody], r: usize) {
+        let k = self.rows.len();
         // B = G R_C, then A⁻¹ B beside it.
         let mut b_psi = Mat::<Real>::zeros(k, 2 * r);
-        for (e, row) in rows.iter().enumerate() {
+        for (e, row) in self.rows.iter().enumerate() {
             for &(b, s, v) in &row.entries {
                 for (j, mode) in bodies[b].modes_c.iter().enumerate() {
-                    b_psi[(e, first[b] + j)] += v * mode[s];
-                    b_psi[(e, r + first[b] + j)] += v * mode[s];
+                    b_psi[(e, self.first[b] + j)] += v * mode[s];
+                    b_psi[(e, r + self.first[b] + j)] += v * mode[s];
                 }
             }
         }
-        llt.solve_in_place(b_psi.subcols_mut(r, r));
+        self.llt.solve_in_place(b_psi.subcols_mut(r, r));
         let mut m = nalgebra::DMatrix::<Real>::zeros(r, r);
         for i in 0..r {
             for j in 0..r {
@@ -207,17 +378,48 @@ impl ContactJacobian {
         }
         // With slipping contacts `Bᵀ A⁻¹ B` is unsymmetric: the held rigid motions are decided
         // on its symmetric part and, when all are held, solved with the whole of it.
-        let full = matches!(llt, Inverse::General { .. }).then(|| m.clone().lu());
+        self.rigid_lu = matches!(self.llt, Inverse::Friction(_)).then(|| m.clone().lu());
         let m = (&m + m.transpose()) * 0.5;
-        Ok(ContactJacobian {
-            rows,
-            llt,
-            b_psi,
-            first,
-            eigen: (r > 0).then(|| m.symmetric_eigen()),
-            rigid_lu: full,
-            stabilisation,
-        })
+        self.eigen = (r > 0).then(|| m.symmetric_eigen());
+        self.b_psi = b_psi;
+    }
+
+    /// Whether the Jacobian is of contacts with friction.
+    pub(crate) fn has_friction(&self) -> bool {
+        matches!(self.llt, Inverse::Friction(_))
+    }
+
+    /// Take which contacts slip, and their stiffnesses, from `rows` (the same contacts at a
+    /// later iterate) into a Jacobian with friction, keeping its `G C Gᵀ`, its factor and its
+    /// rows' directions (a modified Newton step in `G`, exact in the friction law's state):
+    /// `false`, and nothing changed, if it has no friction or `rows` are other contacts.
+    pub(crate) fn restiffen(&mut self, bodies: &[&CondensedBody], rows: &[ContactRow]) -> bool {
+        if !self.has_friction() || rows.len() != self.rows.len() {
+            return false;
+        }
+        let same =
+            self.rows
+                .iter()
+                .zip(rows)
+                .all(|(old, new)| match (&old.friction, &new.friction) {
+                    (Some(a), Some(b)) => a.first == b.first && a.count == b.count,
+                    (None, None) => true,
+                    _ => false,
+                });
+        if !same {
+            return false;
+        }
+        for (old, new) in self.rows.iter_mut().zip(rows) {
+            if let (Some(a), Some(b)) = (&mut old.friction, &new.friction) {
+                a.slipping = b.slipping;
+            }
+        }
+        if let Inverse::Friction(f) = &mut self.llt {
+            f.set_stiffness(&self.rows);
+        }
+        let r = self.b_psi.ncols() / 2;
+        self.rigid(bodies, r);
+        true
     }
 
     /// The contact rows the Jacobian was formed with.
@@ -302,6 +504,97 @@ impl ContactJacobian {
             fhat,
             alpha,
             stabilised,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{DMatrix, DVector};
+
+    /// Rows of two contacts of three rows each along x, y, z, with stick stiffnesses `r`
+    /// and each contact's slipping block (`None`: sticking).
+    fn rows(r: &[Real; 6], slipping: [Option<Matrix3<Real>>; 2]) -> Vec<ContactRow> {
+        (0..6)
+            .map(|i| ContactRow {
+                penalty: r[i],
+                entries: Vec::new(),
+                friction: Some(FrictionRow {
+                    first: 3 * (i / 3),
+                    count: 3,
+                    axis: Vector3::ith(i % 3, 1.0),
+                    slipping: slipping[i / 3],
+                }),
+            })
+            .collect()
+    }
+
+    /// `(I + κ A)⁻¹ κ x` by a dense LU of the whole matrix, κ block-diagonal.
+    fn direct(
+        a: &DMatrix<Real>,
+        r: &[Real; 6],
+        slipping: [Option<Matrix3<Real>>; 2],
+        x: &DVector<Real>,
+    ) -> DVector<Real> {
+        let mut kappa = DMatrix::<Real>::zeros(6, 6);
+        for c in 0..2 {
+            for i in 0..3 {
+                for j in 0..3 {
+                    kappa[(3 * c + i, 3 * c + j)] = match slipping[c] {
+                        Some(k3) => k3[(i, j)],
+                        None if i == j => r[3 * c + i],
+                        None => 0.0,
+                    };
+                }
+            }
+        }
+        let m = DMatrix::<Real>::identity(6, 6) + &kappa * a;
+        m.lu().solve(&(&kappa * x)).expect("regular")
+    }
+
+    #[test]
+    fn the_schur_complement_on_slipping_rows_solves_the_whole_unsymmetric_jacobian() {
+        // A symmetric positive definite G C Gᵀ, stick stiffnesses (k_n, k_t, k_t) per contact
+        // and a slipping block: k_n along the normal (x), unsymmetric, singular along y.
+        let b = DMatrix::<Real>::from_fn(6, 6, |i, j| {
+            ((i * 7 + j * 3) % 5) as Real * 0.1 + if i == j { 0.5 } else { 0.0 }
+        });
+        let a = &b * b.transpose();
+        let r = [4.0, 2.0, 2.0, 5.0, 3.0, 3.0];
+        let slip = Matrix3::new(5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.5, 0.0, 0.8);
+        let x = DVector::from_vec(vec![1.0, -2.0, 0.5, 3.0, -1.0, 2.0]);
+        let mut f = Mat::<Real>::zeros(6, 6);
+        for i in 0..6 {
+            for j in 0..6 {
+                f[(i, j)] = a[(i, j)] + if i == j { 1.0 / r[i] } else { 0.0 };
+            }
+        }
+        // Sticking, the second contact slipping, then the first slipping instead (the columns
+        // of L⁻¹ kept from before for the second).
+        let states = [
+            [None, None],
+            [None, Some(slip)],
+            [Some(slip), None],
+            [Some(slip), Some(slip)],
+        ];
+        let mut inverse = FrictionInverse::new(f, &rows(&r, states[0])).expect("positive definite");
+        for state in states {
+            inverse.set_stiffness(&rows(&r, state));
+            let expected = direct(&a, &r, state, &x);
+            let mut y = Mat::<Real>::zeros(6, 1);
+            for i in 0..6 {
+                y[(i, 0)] = x[i];
+            }
+            inverse.solve_in_place(y.as_mut());
+            for i in 0..6 {
+                assert!(
+                    (y[(i, 0)] - expected[i]).abs() <= 1e-12 * expected.amax(),
+                    "{state:?} row {i}: {} against {}",
+                    y[(i, 0)],
+                    expected[i]
+                );
+            }
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Linear bodies in contact, factored once per run and condensed on their contact candidates: the body, the contact Jacobian and the condensed Newton.
 
 pub(crate) use self::body::{CondenseFailure, CondensedBody, NOT_CANDIDATE};
-pub(crate) use self::jacobian::{ContactJacobian, ContactRow, Correction};
+pub(crate) use self::jacobian::{ContactJacobian, ContactRow, Correction, FrictionRow};
 pub(crate) use self::solver::CondensedSolver;
 
 mod body;

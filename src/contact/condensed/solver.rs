@@ -1,11 +1,12 @@
 //! The condensed Newton of the settle loop when every body is linear: on the contact candidates only, each body factored once per run.
 
 use crate::contact::condensed::{
-    CondenseFailure, CondensedBody, ContactJacobian, ContactRow, Correction, NOT_CANDIDATE,
+    CondenseFailure, CondensedBody, ContactJacobian, ContactRow, Correction, FrictionRow,
+    NOT_CANDIDATE,
 };
 use crate::contact::detect::widen;
 use crate::contact::settle::{largest_nodal_move, BodyPart, Problem, STABILISATION};
-use crate::contact::{ActiveContact, ContactError, ContactSet};
+use crate::contact::{ActiveContact, ContactError, ContactSet, SlipState};
 use crate::linkage::body_state::norm;
 use crate::linkage::line_search::backtrack;
 use crate::linkage::{Body, Convergence, Mechanism, PhaseTimes};
@@ -315,23 +316,28 @@ impl CondensedSolver {
                 }
                 entries
             };
-            let (Some(stiffness), Some(_)) = (e.stiffness(), &e.tangential) else {
+            let (Some(stiffness), Some(tangential)) = (e.stiffness(), &e.tangential) else {
                 let entries = row(&n, &mut missing);
                 if !entries.is_empty() && e.penalty.stiffness > 0.0 {
                     rows.push(ContactRow {
                         penalty: e.penalty.stiffness,
                         entries,
-                        coupling: Vec::new(),
+                        friction: None,
                     });
                 }
                 continue;
             };
-            // With friction: a row along the normal and one along each tangent direction,
-            // coupled by the contact's stiffness in that basis.
-            let mut k3 = stiffness;
-            if let Some((a, b)) = e.rank_one() {
-                k3 += a * b.transpose();
-            }
+            // With friction: a row along the normal and one along each tangent direction. A
+            // sticking contact's stiffness is `k_n` along its normal and `k_t` along its
+            // tangents; a slipping one's is the whole block (unsymmetric), kept in Cartesian
+            // form so that a Jacobian kept for later iterations can turn it into its own axes.
+            let slipping = (tangential.state == SlipState::Slip).then(|| {
+                let mut k3 = stiffness;
+                if let Some((a, b)) = e.rank_one() {
+                    k3 += a * b.transpose();
+                }
+                k3
+            });
             let axes = contact_axes(&n, parts[e.contact.body].dofs.dofs_per_node);
             let first = rows.len();
             let mut added = Vec::with_capacity(axes.len());
@@ -341,17 +347,20 @@ impl CondensedSolver {
             if added.iter().all(|r| r.is_empty()) {
                 continue;
             }
-            for (i, (entries, ei)) in added.into_iter().zip(&axes).enumerate() {
-                let coupling = axes
-                    .iter()
-                    .enumerate()
-                    .filter(|&(j, _)| j != i)
-                    .map(|(j, ej)| (first + j, ei.dot(&(k3 * ej))))
-                    .collect();
+            for (i, (entries, axis)) in added.into_iter().zip(&axes).enumerate() {
                 rows.push(ContactRow {
-                    penalty: ei.dot(&(k3 * ei)),
+                    penalty: if i == 0 {
+                        e.penalty.stiffness
+                    } else {
+                        tangential.stick_stiffness
+                    },
                     entries,
-                    coupling,
+                    friction: Some(FrictionRow {
+                        first,
+                        count: axes.len(),
+                        axis: *axis,
+                        slipping,
+                    }),
                 });
             }
         }
@@ -544,6 +553,8 @@ impl CondensedSolver {
         let fresh = self.bodies.iter().all(|c| c.fresh);
         // The residual of the state the line search accepted (evaluated there already).
         let mut pending = None;
+        // Slow iterations (see `FRICTION_SLOW_ITERATIONS`) with the kept friction Jacobian.
+        let mut slow = 0;
         loop {
             let t = Instant::now();
             let evaluated = match pending.take() {
@@ -584,11 +595,21 @@ impl CondensedSolver {
             // Near the round-off floor the Jacobian's age no longer matters.
             // A Jacobian carried over from an earlier call is tried once.
             let near_floor = monitor.last().is_some_and(|r| r < 1e3 * p.tolerance);
-            let reuse = jacobian.as_ref().is_some_and(|j: &ContactJacobian| {
-                j.rows().len() == residual.rows.len()
-                    && (monitor.len() < 2 || monitor.converging_fast() || near_floor)
-            });
+            let fast = monitor.len() < 2 || monitor.converging_fast() || near_floor;
+            let mut reuse = jacobian
+                .as_ref()
+                .is_some_and(|j: &ContactJacobian| j.rows().len() == residual.rows.len() && fast);
+            // With friction, contacts that start or stop slipping change only the contacts'
+            // stiffness: taken into the kept Jacobian (a Schur complement on the slipping
+            // rows), its `G C Gᵀ` and factor are formed again only after slow iterations.
+            if let Some(j) = jacobian.as_mut().filter(|j| j.has_friction()) {
+                if !fast {
+                    slow += 1;
+                }
+                reuse = slow < FRICTION_SLOW_ITERATIONS && j.restiffen(&views, &residual.rows);
+            }
             if !reuse {
+                slow = 0;
                 *jacobian = ContactJacobian::new(&views, residual.rows, stabilisation).ok();
             }
             let Some(jac) = jacobian.as_ref() else {
@@ -646,6 +667,10 @@ impl CondensedSolver {
         None
     }
 }
+
+/// Slow iterations (a residual not below a tenth of the one before) a Jacobian with friction
+/// is kept for, its contacts' stiffnesses brought up to date, before it is formed again.
+const FRICTION_SLOW_ITERATIONS: usize = 3;
 
 /// Add a condensation's analysis, factorization and solve times to `times`.
 fn add_seconds(times: &mut PhaseTimes, c: &CondensedBody) {
