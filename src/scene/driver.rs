@@ -139,6 +139,7 @@ fn run_in(
                 body: b.name.clone(),
                 member: r.member,
                 load_factor: r.load_factor,
+                tooth: r.tooth,
             }));
         }
         if step == 0 {
