@@ -92,3 +92,50 @@ penalty = 1e9
     .unwrap();
     assert_eq!(step4["bodies"][0]["breaks"][0]["member"], 2);
 }
+
+/// Breaking members with friction are not supported yet: refused with an error naming the body
+/// and what to change, before anything is solved.
+#[test]
+fn breaking_members_with_friction_are_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("t.nodes"), "0 0\n-1 1\n0 1\n1 1\n").unwrap();
+    std::fs::write(d.join("t.links"), "1 2\n1 3\n1 4\n").unwrap();
+    let scene = d.join("rough.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "rough"
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+compressive_strength = 250e6
+failure = "break"
+[[bodies]]
+name = "truss"
+nodes = "t.nodes"
+links = "t.links"
+material = "steel"
+[[bodies.supports]]
+nodes = [2, 3, 4]
+fix = ["x", "y"]
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, -0.001]
+normal = [0.0, 1.0]
+travel = [0.0, 0.003]
+[contact]
+friction = 0.3
+"#,
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    let err = run(&world, &d.join("out"), &|| {}).unwrap_err();
+    let text = format!("{err:#}");
+    assert!(
+        text.contains("body 'truss'") && text.contains("friction"),
+        "{text}"
+    );
+    assert!(!d.join("out/rough").exists());
+}
