@@ -139,3 +139,98 @@ friction = 0.3
     );
     assert!(!d.join("out/rough").exists());
 }
+
+/// Softening under contact: a triangle, A = (−1, 0) pinned, B = (1, 0) on a roller, apex
+/// C = (0, 1), pressed down at C by a half-space `gap` = 1 mm above it through `travel`; the
+/// tie AB (length 2) softens in 3 teeth (f_t = 25 MPa, G_f = 20 kJ/m²), the diagonals do not
+/// break; E A = 2e7 N, penalty k = 1e9 N/m. The truss is determinate: the tie carries P/2 and
+/// C sinks `δ = P (√2/(E A) + 1/(4 kᵢ))` (unit load: each diagonal n = 1/√2 over √2 m, the tie
+/// n = 1/2 at its tooth's stiffness kᵢ). Tooth i is reached at `Pᵢ = 2 σᵢ A`, so at the travel
+/// factor `λᵢ = (gap + Pᵢ/k + Pᵢ (√2/(E A) + 1/(4 kᵢ))) / travel`, kᵢ and σᵢ from the tie's
+/// teeth. Teeth 1 and 2 are passed there (1e-8), and the last breaks the tie there; then the
+/// truss is a mechanism the press folds, and it carries nothing.
+#[test]
+fn a_softening_tie_under_contact_passes_its_teeth_at_the_hand_loads_then_breaks() {
+    use linkage::linkage::fracture::saw_tooth;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (e, a, ft, gf, n, k, gap) = (200e9, 1e-4, 25e6, 20000.0, 3usize, 1e9, 1e-3);
+    let ea = e * a;
+    let teeth = saw_tooth(e, ft, 2.0, gf, n).unwrap();
+    let lambda_of = |i: usize, travel: f64| {
+        let ki = teeth[i].stiffness_factor * ea / 2.0;
+        let p = 2.0 * teeth[i].tensile_strength * a;
+        (gap + p / k + p * (2f64.sqrt() / ea + 1.0 / (4.0 * ki))) / travel
+    };
+    // Past the last tooth's load by a third.
+    let travel = 1.37 * lambda_of(n - 1, 1.0);
+    std::fs::write(d.join("t.nodes"), "-1 0\n1 0\n0 1\n").unwrap();
+    std::fs::write(d.join("t.links"), "1 2\n1 3 strong\n2 3 strong\n").unwrap();
+    let scene = d.join("tie.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "tie"
+steps = 7
+[[materials]]
+name = "steel"
+youngs_modulus = {e:e}
+area = {a:e}
+tensile_strength = {ft:e}
+failure = "break"
+softening = {{ fracture_energy = {gf}, teeth = {n} }}
+[[materials]]
+name = "strong"
+youngs_modulus = {e:e}
+area = {a:e}
+[[bodies]]
+name = "truss"
+nodes = "t.nodes"
+links = "t.links"
+material = "steel"
+[[bodies.supports]]
+nodes = [1]
+fix = ["x", "y"]
+[[bodies.supports]]
+nodes = [2]
+fix = ["y"]
+[[obstacles]]
+name = "press"
+shape = "half_space"
+point = [0.0, {}]
+normal = [0.0, -1.0]
+travel = [0.0, {}]
+[contact]
+penalty = {k:e}
+"#,
+            1.0 + gap,
+            -travel
+        ),
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    let summary = run(&world, &d.join("out"), &|| {}).expect("a result");
+    assert_eq!(summary.breaks.len(), n, "{:?}", summary.breaks);
+    for (i, b) in summary.breaks.iter().enumerate() {
+        assert_eq!((b.member, b.tooth), (1, (i + 1 < n).then_some(i + 1)));
+        let expected = lambda_of(i, travel);
+        assert!(
+            close(b.load_factor, expected, 1e-8),
+            "tooth {i}: {} against {expected}",
+            b.load_factor
+        );
+    }
+    // With the tie gone the truss is a mechanism that the press folds without resistance
+    // (linear kinematics, frictionless contact): the last step carries nothing. (It is not
+    // reported as a collapse: the coupled solve finds that force-free state.)
+    assert!(summary.collapse.is_none() && summary.failure.is_none());
+    let last: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("out/tie/steps/0007.json")).unwrap())
+            .unwrap();
+    let body = &last["bodies"][0];
+    assert_eq!(body["broken"], serde_json::json!([1]));
+    let p0 = 2.0 * ft * a;
+    for f in body["axial_forces"].as_array().unwrap() {
+        assert!(f.as_f64().unwrap().abs() <= 1e-6 * p0, "{f}");
+    }
+}
