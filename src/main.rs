@@ -513,8 +513,12 @@ fn run_scenes(
                         println!("warn  {}: {w}", world.name);
                     }
                 }
-                if !summary.breaks.is_empty() {
-                    println!("      {} member(s) broke", summary.breaks.len());
+                let teeth = summary.breaks.iter().filter(|b| b.tooth.is_some()).count();
+                if summary.breaks.len() > teeth {
+                    println!("      {} member(s) broke", summary.breaks.len() - teeth);
+                }
+                if teeth > 0 {
+                    println!("      {teeth} softening tooth/teeth passed");
                 }
                 if let Some(c) = &summary.collapse {
                     println!(

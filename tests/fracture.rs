@@ -418,3 +418,274 @@ fn a_collapse_is_a_result_in_the_batch_table_with_the_members_broken() {
         "{row} should hold broken = {broken_last}"
     );
 }
+
+/// Softening material of the tests below: E = 30 GPa, A = 1 cm², f_t = 3 MPa, G_f = 100 J/m².
+const SOFT_E: f64 = 30e9;
+const SOFT_A: f64 = 1e-4;
+const SOFT_FT: f64 = 3e6;
+const SOFT_GF: f64 = 100.0;
+
+/// Run a 2D bar along x, its nodes at `xs` (m), its first member of the softening material
+/// with `teeth` teeth (none: brittle), the others of `stiff` (E = 30 GPa, A = 1 cm², not
+/// breaking), node 1 held, the last node pulled `travel` m along x over `steps` steps, every
+/// node held in y.
+fn run_softening_bar(
+    dir: &Path,
+    name: &str,
+    xs: &[f64],
+    teeth: Option<usize>,
+    travel: f64,
+    steps: usize,
+) -> Summary {
+    let nodes: String = xs.iter().map(|x| format!("{x} 0\n")).collect();
+    let links: String = (1..xs.len())
+        .map(|i| {
+            if i == 1 {
+                "1 2\n".to_string()
+            } else {
+                format!("{i} {} stiff\n", i + 1)
+            }
+        })
+        .collect();
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(dir.join(format!("{name}.nodes")), nodes).unwrap();
+    std::fs::write(dir.join(format!("{name}.links")), links).unwrap();
+    let softening = teeth.map_or(String::new(), |n| {
+        format!("softening = {{ fracture_energy = {SOFT_GF}, teeth = {n} }}")
+    });
+    let last = xs.len();
+    let scene = dir.join(format!("{name}.toml"));
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "{name}"
+steps = {steps}
+[[materials]]
+name = "soft"
+youngs_modulus = {SOFT_E:e}
+area = {SOFT_A:e}
+tensile_strength = {SOFT_FT:e}
+failure = "break"
+{softening}
+[[materials]]
+name = "stiff"
+youngs_modulus = {SOFT_E:e}
+area = {SOFT_A:e}
+[[bodies]]
+name = "bar"
+nodes = "{name}.nodes"
+links = "{name}.links"
+material = "soft"
+[[bodies.supports]]
+nodes = [1]
+fix = ["x", "y"]
+{}[[bodies.supports]]
+nodes = [{last}]
+fix = ["x", "y"]
+displacement = [{travel:e}, 0.0]
+"#,
+            if last > 2 {
+                let middle: Vec<String> = (2..last).map(|n| n.to_string()).collect();
+                format!(
+                    "[[bodies.supports]]\nnodes = [{}]\nfix = [\"y\"]\n",
+                    middle.join(", ")
+                )
+            } else {
+                String::new()
+            }
+        ),
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    run(&world, &dir.join("out"), &|| {}).expect("the run ends with a result")
+}
+
+/// One softening member of length L = 0.1 m pulled by its end through 5 teeth. Tooth i has
+/// the strength σᵢ = f_t (1 − i/5) by definition; the member reaches it at the elongation δᵢ
+/// recorded as the event's load factor times the travel. Since the elongation is prescribed,
+/// the force is `kᵢ δ` between events with `kᵢ = σᵢ A / δᵢ`: every step's axial force follows
+/// that saw-tooth (1e-9), and the energy the drops release, `Σ ½ (kᵢ − kᵢ₊₁) δᵢ²` from the
+/// recorded events alone, is G_f A = 0.01 J (1e-9). The first tooth is the brittle strength:
+/// δ₀ = f_t L / E exactly. The breaks list the teeth 1–4 with `tooth`, the last break without;
+/// `broken` holds the member only after it.
+#[test]
+fn a_softening_member_follows_its_saw_tooth_and_dissipates_the_fracture_energy() {
+    let dir = tempfile::tempdir().unwrap();
+    let (l, n, steps) = (0.1, 5usize, 80usize);
+    // The last tooth's strain is below G_f/(L f_t) · 2 (a saw-tooth dissipates less than
+    // its line's area): travel to 1.5 times that.
+    // (Not a round multiple of δ₀: a tooth exactly at a step's end would be taken in the
+    // next step, at fraction 0.)
+    let travel = 1.537 * 2.0 * SOFT_GF / SOFT_FT;
+    let summary = run_softening_bar(dir.path(), "one", &[0.0, l], Some(n), travel, steps);
+    assert!(summary.collapse.is_none() && summary.failure.is_none());
+    let events = &summary.breaks;
+    assert_eq!(events.len(), n, "{events:?}");
+    for (i, e) in events.iter().enumerate() {
+        assert_eq!(e.member, 1);
+        assert_eq!(e.tooth, (i + 1 < n).then_some(i + 1));
+    }
+    let delta: Vec<f64> = events.iter().map(|e| e.load_factor * travel).collect();
+    assert!(close(delta[0], SOFT_FT * l / SOFT_E, 1e-9));
+    let sigma = |i: usize| SOFT_FT * (1.0 - i as f64 / n as f64);
+    let k = |i: usize| {
+        if i < n {
+            sigma(i) * SOFT_A / delta[i]
+        } else {
+            0.0
+        }
+    };
+    assert!(close(k(0), SOFT_E * SOFT_A / l, 1e-9));
+    let dissipated: f64 = (0..n)
+        .map(|i| 0.5 * (k(i) - k(i + 1)) * delta[i] * delta[i])
+        .sum();
+    assert!(
+        close(dissipated, SOFT_GF * SOFT_A, 1e-9),
+        "{dissipated} J against G_f A = {} J",
+        SOFT_GF * SOFT_A
+    );
+    // Teeth in different steps, so each step file can be checked against the saw-tooth.
+    let steps_with_events: std::collections::BTreeSet<usize> =
+        events.iter().map(|e| e.step).collect();
+    assert_eq!(steps_with_events.len(), n);
+    for s in 0..=steps {
+        let d = travel * s as f64 / steps as f64;
+        let passed = delta.iter().filter(|&&di| di <= d).count();
+        let expected = k(passed) * d;
+        let file = step_file(dir.path(), "one", s).unwrap();
+        let body = &file["bodies"][0];
+        let force = body["axial_forces"][0].as_f64().unwrap();
+        assert!(
+            (force - expected).abs() <= 1e-9 * SOFT_FT * SOFT_A,
+            "step {s}: {force} N against {expected} N"
+        );
+        let broken = body["broken"].as_array().unwrap().len();
+        assert_eq!(broken, usize::from(passed == n), "step {s}");
+    }
+}
+
+/// Three members in series (0.1 m each), the first softening (5 teeth), pulled at the far end:
+/// the middle nodes are free, so each tooth goes through the Woodbury update of the factored
+/// K. The bar's force is `F = δ / (1/kᵢ + 2/k)` with `kᵢ` the softening member's stiffness at
+/// its tooth and k = E A / L of the others; the member reaches tooth i's strength σᵢ at
+/// `δᵢ = σᵢ A (1/kᵢ + 2/k)`, with `kᵢ` from the member's own teeth (their elongations, found
+/// by the one-member case through `saw_tooth`). Every event's load factor and every step's
+/// force to 1e-9.
+#[test]
+fn a_softening_member_in_series_passes_its_teeth_at_the_hand_loads() {
+    use linkage::linkage::fracture::saw_tooth;
+    let dir = tempfile::tempdir().unwrap();
+    let (l, n, steps) = (0.1, 5usize, 60usize);
+    let teeth = saw_tooth(SOFT_E, SOFT_FT, l, SOFT_GF, n).unwrap();
+    let k = SOFT_E * SOFT_A / l;
+    let ki = |i: usize| teeth.get(i).map_or(0.0, |t| t.stiffness_factor * k);
+    let compliance = |i: usize| 1.0 / ki(i) + 2.0 / k;
+    let delta: Vec<f64> = (0..n)
+        .map(|i| teeth[i].tensile_strength * SOFT_A * compliance(i))
+        .collect();
+    let travel = 1.237 * delta[n - 1];
+    let summary = run_softening_bar(
+        dir.path(),
+        "series",
+        &[0.0, l, 2.0 * l, 3.0 * l],
+        Some(n),
+        travel,
+        steps,
+    );
+    assert!(summary.collapse.is_none() && summary.failure.is_none());
+    let events = &summary.breaks;
+    assert_eq!(events.len(), n, "{events:?}");
+    for (i, e) in events.iter().enumerate() {
+        assert_eq!((e.member, e.tooth), (1, (i + 1 < n).then_some(i + 1)));
+        assert!(
+            close(e.load_factor * travel, delta[i], 1e-9),
+            "tooth {i}: {} m against {} m",
+            e.load_factor * travel,
+            delta[i]
+        );
+    }
+    for s in 0..=steps {
+        let d = travel * s as f64 / steps as f64;
+        let passed = delta.iter().filter(|&&di| di <= d).count();
+        let expected = if passed == n {
+            0.0
+        } else {
+            d / compliance(passed)
+        };
+        let file = step_file(dir.path(), "series", s).unwrap();
+        let forces = file["bodies"][0]["axial_forces"]
+            .as_array()
+            .unwrap()
+            .clone();
+        for f in forces {
+            let f = f.as_f64().unwrap();
+            assert!(
+                (f - expected).abs() <= 1e-9 * SOFT_FT * SOFT_A,
+                "step {s}: {f} N against {expected} N"
+            );
+        }
+    }
+}
+
+/// One tooth is the brittle member: the same run with `teeth = 1` and without softening gives
+/// byte-identical step files and the same summary breaks.
+#[test]
+fn one_tooth_is_exactly_brittle() {
+    let dir = tempfile::tempdir().unwrap();
+    let xs = [0.0, 0.1, 0.2];
+    let travel = 3.1e-5;
+    let a = run_softening_bar(&dir.path().join("a"), "bar", &xs, Some(1), travel, 4);
+    let b = run_softening_bar(&dir.path().join("b"), "bar", &xs, None, travel, 4);
+    assert_eq!(a.breaks, b.breaks);
+    assert_eq!(a.breaks.len(), 1);
+    assert_eq!(a.breaks[0].tooth, None);
+    for s in 0..=4 {
+        let read = |d: &str| {
+            std::fs::read(dir.path().join(format!("{d}/out/bar/steps/{s:04}.json"))).unwrap()
+        };
+        assert_eq!(read("a"), read("b"), "step {s}");
+    }
+}
+
+/// A fracture energy below what a member dissipates breaking at once, f_t² L/(2E), is refused
+/// naming the body and the member: with L = 0.1 m that least is 15 J/m².
+#[test]
+fn too_little_fracture_energy_is_refused_naming_the_member() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("brittle.toml");
+    std::fs::write(dir.path().join("b.nodes"), "0 0\n0.1 0\n").unwrap();
+    std::fs::write(dir.path().join("b.links"), "1 2\n").unwrap();
+    std::fs::write(
+        &scene,
+        r#"name = "brittle"
+[[materials]]
+name = "soft"
+youngs_modulus = 30e9
+area = 1e-4
+tensile_strength = 3e6
+failure = "break"
+softening = { fracture_energy = 14.0, teeth = 4 }
+[[bodies]]
+name = "bar"
+nodes = "b.nodes"
+links = "b.links"
+material = "soft"
+[[bodies.supports]]
+nodes = [1]
+fix = ["x", "y"]
+[[bodies.supports]]
+nodes = [2]
+fix = ["x", "y"]
+displacement = [1e-4, 0.0]
+"#,
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    let err = run(&world, &dir.path().join("out"), &|| {}).unwrap_err();
+    let text = format!("{err:#}");
+    assert!(
+        text.contains("body 'bar'") && text.contains("member 1"),
+        "{text}"
+    );
+    assert!(text.contains("fracture_energy = 14 J/m²"), "{text}");
+}

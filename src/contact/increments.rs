@@ -139,6 +139,35 @@ impl ContactSolver {
         Ok(reported)
     }
 
+    /// Settle at pseudo-time `t` of `steps` (within `step`) from the current state, solved at
+    /// pseudo-time `from`, in one increment: breaking members move the load back and forth
+    /// within a step (see `ContactFracture`). The converged path is left alone.
+    pub(crate) fn settle_at(
+        &mut self,
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        from: Real,
+        t: Real,
+        steps: usize,
+        step: usize,
+    ) -> Result<ContactStep, ContactError> {
+        self.geometry
+            .record_sides(bodies, &self.parts, &self.active);
+        let offsets_there = obstacles.iter().map(|o| o.offset_at(from, steps)).collect();
+        self.geometry
+            .record_crossings(bodies, &self.parts, &self.active, offsets_there);
+        self.settle(bodies, obstacles, t, steps, step)
+    }
+
+    /// Start the converged path over from the current state at the step solved: after members
+    /// broke, the states before belong to another structure.
+    pub(crate) fn restart_path(&mut self) {
+        self.path = vec![(
+            self.step as Real,
+            self.parts.iter().map(|p| p.u.clone()).collect(),
+        )];
+    }
+
     /// The problem of the current state with `set`, `forces` (N per body DOF) and the obstacles
     /// at `offsets` (m), for `step`: the contact Newton's limits and friction's history.
     fn problem<'a>(

@@ -3,6 +3,7 @@
 pub use self::boundary::boundary_loop;
 pub use self::contact_set::{ActiveContact, ContactSet, NodeContact, Target};
 pub use self::error::ContactError;
+pub use self::fracture::{ContactFracture, FractureStop, AT_STRENGTH};
 pub use self::friction::{
     return_mapping, Committed, FrictionHistory, FrictionKey, FrictionPair, FrictionSettings,
     SlipState, Tangential,
@@ -28,6 +29,7 @@ mod cylinder_rim;
 mod detect;
 mod error;
 mod evaluate;
+mod fracture;
 mod friction;
 mod increments;
 mod mesh_orientation;

@@ -251,7 +251,13 @@ impl ContactSolver {
             CoupledIterative::new(bodies, &dofs, &assemblies)
         };
         // Condensing needs a factorization of every body: not for one solved iteratively.
-        if settings.condense && iterative.is_none() && bodies.iter().all(|b| !b.is_nonlinear()) {
+        // Nor for a body whose members break: a break changes the compliance condensed.
+        if settings.condense
+            && iterative.is_none()
+            && bodies
+                .iter()
+                .all(|b| !b.is_nonlinear() && !crate::linkage::fracture::breaks_members(b))
+        {
             // Obstacle offsets along their travel, sampled (a candidate missed is added later).
             let travels: Vec<Vec<Vector3<Real>>> = obstacles
                 .iter()

@@ -102,6 +102,20 @@ pub enum SolveError {
         /// The breaks of that step, the last one included.
         breaks: Vec<crate::linkage::fracture::BreakEvent>,
     },
+    /// A softening member's fracture energy is less than it dissipates breaking brittle.
+    #[error("body '{body}': member {}: softening.fracture_energy = {fracture_energy} J/m² is below the {least:e} J/m² the member dissipates breaking at once (f_t² L/(2E), length {length} m): raise fracture_energy above it, or use teeth = 1 (brittle)", .member + 1)]
+    SofteningTooBrittle {
+        /// Body name.
+        body: String,
+        /// The member, 0-based.
+        member: usize,
+        /// The material's G_f, J/m².
+        fracture_energy: Real,
+        /// The least G_f the member can have, J/m².
+        least: Real,
+        /// Its undeformed length, m.
+        length: Real,
+    },
     /// Breaking members are not supported for this body.
     #[error("body '{body}': members of a material with failure = \"break\" {reason}: use failure = \"mark\" for this body, or {remedy}")]
     BreakingUnsupported {

@@ -45,6 +45,17 @@ pub struct Scatter {
     pub seed: u64,
 }
 
+/// The saw-tooth softening of breaking members (see `linkage::fracture::saw_tooth`): each
+/// member passes through `teeth` teeth of falling stiffness and strength before it breaks,
+/// dissipating `fracture_energy` over its cross-section.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Softening {
+    /// Fracture energy G_f, J/m² (per unit of the member's cross-section area); finite, > 0.
+    pub fracture_energy: Real,
+    /// Number of teeth n ≥ 1 (1: brittle).
+    pub teeth: usize,
+}
+
 /// The material and cross-section of a member: what the paper's `AE` is made of.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -64,6 +75,8 @@ pub struct Material {
     pub failure: Failure,
     /// Scatter of the strengths of breaking members (none: every member has the strength).
     pub scatter: Option<Scatter>,
+    /// Saw-tooth softening of breaking members (none: they break at their strength).
+    pub softening: Option<Softening>,
 }
 
 impl Material {
@@ -78,6 +91,7 @@ impl Material {
             behaviour: Behaviour::Elastic,
             failure: Failure::Mark,
             scatter: None,
+            softening: None,
         }
     }
 
@@ -131,6 +145,17 @@ impl Material {
                     "scatter.weibull_modulus = {} must be a finite positive number",
                     scatter.weibull_modulus
                 ));
+            }
+        }
+        if let Some(softening) = self.softening {
+            if !positive(softening.fracture_energy) {
+                return Some(format!(
+                    "softening.fracture_energy = {} must be a finite positive number of J/m²",
+                    softening.fracture_energy
+                ));
+            }
+            if softening.teeth == 0 {
+                return Some("softening.teeth = 0: give at least 1 tooth (1 is brittle)".into());
             }
         }
         None

@@ -12,7 +12,7 @@ pub use self::dof_map::{direction_name, DofMap, DofSlot};
 pub use self::equilibrium::{Equilibrium, PhaseTimes, SolveError};
 pub use self::geometry::Geometry;
 pub use self::kinematics::{Kinematics, NewtonSettings, PathMethod};
-pub use self::material::{Behaviour, Failure, Material, Scatter};
+pub use self::material::{Behaviour, Failure, Material, Scatter, Softening};
 pub use self::mechanism::Mechanism;
 pub use self::member_check::check_members;
 pub use self::member_response::{member_response, MemberResponse};

@@ -5,7 +5,7 @@ use crate::linkage::generators;
 use crate::linkage::prepare::PrepareReport;
 use crate::linkage::{
     Behaviour, Body, Dimension, Failure, Geometry, Kinematics, Material, Member, NewtonSettings,
-    NodalLoad, PathMethod, Scatter, Schedule, SolverChoice, SolverSettings, Support,
+    NodalLoad, PathMethod, Scatter, Schedule, Softening, SolverChoice, SolverSettings, Support,
 };
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::contact_pairs::friction_settings;
@@ -365,6 +365,10 @@ fn material_from(m: &MaterialSpec) -> Result<Material, String> {
             weibull_modulus: s.weibull_modulus,
             seed: s.seed,
         }),
+        softening: m.softening.as_ref().map(|s| Softening {
+            fracture_energy: s.fracture_energy,
+            teeth: s.teeth,
+        }),
         failure: match m.failure.as_deref() {
             None | Some("mark") => Failure::Mark,
             Some("break") => Failure::Break,
@@ -379,6 +383,18 @@ fn material_from(m: &MaterialSpec) -> Result<Material, String> {
     if material.scatter.is_some() && material.failure != Failure::Break {
         return Err(format!(
             "material '{}': scatter is for breaking members: add failure = \"break\" or remove scatter",
+            m.name
+        ));
+    }
+    if material.softening.is_some() && material.failure != Failure::Break {
+        return Err(format!(
+            "material '{}': softening is for breaking members: add failure = \"break\" or remove softening",
+            m.name
+        ));
+    }
+    if material.softening.is_some() && material.tensile_strength.is_none() {
+        return Err(format!(
+            "material '{}': softening softens members in tension: give strength or tensile_strength in Pa",
             m.name
         ));
     }

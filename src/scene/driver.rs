@@ -142,6 +142,7 @@ fn run_in(
                 body: b.name.clone(),
                 member: r.member,
                 load_factor: r.load_factor,
+                tooth: r.tooth,
             }));
         }
         if step == 0 {

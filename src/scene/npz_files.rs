@@ -94,6 +94,14 @@ pub(crate) fn step_npz(step: &StepResult, dimensions: &[usize]) -> std::io::Resu
                 &[breaks.len()],
                 breaks.iter().map(|b| &b.load_factor),
             )?;
+            // Written only for softening bodies, so other bodies' files keep their arrays.
+            if breaks.iter().any(|b| b.tooth.is_some()) {
+                out.i64s(
+                    &key("breaks_tooth"),
+                    &[breaks.len()],
+                    breaks.iter().map(|b| b.tooth.unwrap_or(0)),
+                )?;
+            }
             out.i64s(&key("fallen"), &[f.fallen.len()], f.fallen.iter().copied())?;
         }
         out.f64s(

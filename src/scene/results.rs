@@ -78,6 +78,10 @@ pub struct BreakRecord {
     /// The load factor (or prescribed-displacement factor) at which it reached its strength:
     /// below the previous break's in a snap-back.
     pub load_factor: Real,
+    /// For a softening member that did not break: the tooth it passed (1-based, below its
+    /// material's `softening.teeth`); absent for a break.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tooth: Option<usize>,
 }
 
 /// The fracture fields of a body at one step.
@@ -85,7 +89,8 @@ pub struct BreakRecord {
 pub struct BodyFracture {
     /// 1-based members broken so far, in the order they broke.
     pub broken: Vec<usize>,
-    /// The breaks of this step, in order.
+    /// The breaks of this step, and the teeth softening members passed (with `tooth`), in
+    /// order.
     pub breaks: Vec<BreakRecord>,
     /// 1-based nodes of pieces that fell off in this step (left without support and removed
     /// from the solve; absent when none).
@@ -104,6 +109,10 @@ pub struct SummaryBreak {
     pub member: usize,
     /// Load factor at which it broke.
     pub load_factor: Real,
+    /// For a softening member that did not break: the tooth it passed (1-based); absent for a
+    /// break.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tooth: Option<usize>,
 }
 
 /// The collapse of a structure: a break left its supported part a mechanism.
@@ -265,7 +274,8 @@ pub struct Summary {
     /// absent when no body was prepared.
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub prepared: std::collections::BTreeMap<String, crate::linkage::prepare::PrepareReport>,
-    /// Every break of the run, in order (absent when nothing broke).
+    /// Every break of the run, and every tooth a softening member passed (with `tooth`), in
+    /// order (absent when nothing broke).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub breaks: Vec<SummaryBreak>,
     /// The structure's collapse, when a break made it a mechanism: the run stopped there with

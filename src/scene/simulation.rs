@@ -1,7 +1,7 @@
 //! One load step of a world: every body solved (alone, or all together with their contacts)
 //! and the step's result and summary line.
 
-use crate::contact::{ContactSolver, NodeContact};
+use crate::contact::{ContactFracture, ContactSolver, FractureStop, NodeContact};
 use crate::linkage::fracture::{breaks_members, BreakEvent, FractureState};
 use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
 use crate::scene::instability::InstabilityWatch;
@@ -31,21 +31,33 @@ pub struct Simulation<'w> {
     pub solver: WorldSolver,
     /// What the instability warnings remember of the previous step.
     watch: InstabilityWatch,
+    /// Breaking members in a scene with contact: the bodies as they break.
+    fracture: Option<ContactFracture>,
 }
 
 impl<'w> Simulation<'w> {
     /// Assemble and factor every body of `world`.
     pub fn new(world: &'w World) -> Result<Self, RunError> {
         if world.has_contact() {
-            if let Some(body) = world.bodies.iter().find(|b| breaks_members(b)) {
-                return Err(RunError::Solve {
-                    scene: world.source.clone(),
-                    source: SolveError::BreakingUnsupported {
-                        body: body.name.clone(),
-                        reason: "are not supported yet in a scene with contact (obstacles or [contact])".to_string(),
-                        remedy: "solve the body without contact (supports and prescribed displacements instead of obstacles)".to_string(),
-                    },
-                });
+            let refused = |body: &Body, reason: &str, remedy: &str| RunError::Solve {
+                scene: world.source.clone(),
+                source: SolveError::BreakingUnsupported {
+                    body: body.name.clone(),
+                    reason: reason.to_string(),
+                    remedy: remedy.to_string(),
+                },
+            };
+            for body in world.bodies.iter().filter(|b| breaks_members(b)) {
+                if body.is_nonlinear() {
+                    return Err(refused(body, "need a linear body, and this one has large kinematics, an arc-length path or tension- or compression-only members", "make the body linear (kinematics = \"linear\", elastic members, path by schedules)"));
+                }
+                if world.contact.friction.any() {
+                    return Err(refused(
+                        body,
+                        "are not supported yet in a scene with friction",
+                        "make the contacts frictionless (no [contact] friction)",
+                    ));
+                }
             }
         }
         let solver = if world.has_contact() {
@@ -68,10 +80,19 @@ impl<'w> Simulation<'w> {
                 })?;
             WorldSolver::Bodies(solvers)
         };
+        let fracture = if world.has_contact() {
+            ContactFracture::new(&world.bodies).map_err(|source| RunError::Solve {
+                scene: world.source.clone(),
+                source,
+            })?
+        } else {
+            None
+        };
         Ok(Simulation {
             world,
             solver,
             watch: InstabilityWatch::default(),
+            fracture,
         })
     }
 
@@ -91,12 +112,34 @@ impl<'w> Simulation<'w> {
         // Per body its state and, with contact, the nodes pressing on something.
         let (states, contacts): (Vec<StepState>, Vec<Vec<NodeContact>>) = match &mut self.solver {
             WorldSolver::Contact(contact) => {
-                let solved = contact
-                    .solve_step(&world.bodies, &world.obstacles, step, world.steps)
-                    .map_err(|source| RunError::Contact {
-                        scene: world.source.clone(),
-                        source,
-                    })?;
+                let contact_error = |source| RunError::Contact {
+                    scene: world.source.clone(),
+                    source,
+                };
+                let (solved, fractures) = match self.fracture.as_mut() {
+                    None => (
+                        contact
+                            .solve_step(&world.bodies, &world.obstacles, step, world.steps)
+                            .map_err(contact_error)?,
+                        Vec::new(),
+                    ),
+                    Some(fr) => match fr.solve_step(contact, &world.obstacles, step, world.steps) {
+                        Ok(solved) => solved,
+                        Err(FractureStop::Contact(e)) => return Err(contact_error(e)),
+                        Err(FractureStop::Collapse {
+                            body,
+                            member,
+                            breaks,
+                        }) => {
+                            let name = &world.bodies[body].name;
+                            return Err(self.collapse(name, step, member, &breaks));
+                        }
+                    },
+                };
+                let mut solved = solved;
+                for (state, f) in solved.states.iter_mut().zip(fractures) {
+                    state.fracture = f;
+                }
                 summary.iterations = solved.newton_iterations;
                 summary.cuts = solved.cuts;
                 summary.negative_pivots = solved.negative_pivots;
@@ -129,24 +172,7 @@ impl<'w> Simulation<'w> {
                             member,
                             breaks,
                         }) => {
-                            let records = self.break_records(&breaks, step);
-                            return Err(RunError::Collapse {
-                                collapse: Collapse {
-                                    step,
-                                    body: body.clone(),
-                                    load_factor: records.last().map_or(0.0, |r| r.load_factor),
-                                    member: member + 1,
-                                },
-                                breaks: records
-                                    .iter()
-                                    .map(|r| SummaryBreak {
-                                        step,
-                                        body: body.clone(),
-                                        member: r.member,
-                                        load_factor: r.load_factor,
-                                    })
-                                    .collect(),
-                            });
+                            return Err(self.collapse(&body, step, member, &breaks));
                         }
                         Err(source) => {
                             return Err(RunError::Solve {
@@ -205,6 +231,30 @@ impl<'w> Simulation<'w> {
         Ok((result, summary))
     }
 
+    /// The collapse of body `body` at `step` by breaking `member` (0-based), `breaks` the
+    /// body's breaks of the step.
+    fn collapse(&self, body: &str, step: usize, member: usize, breaks: &[BreakEvent]) -> RunError {
+        let records = self.break_records(breaks, step);
+        RunError::Collapse {
+            collapse: Collapse {
+                step,
+                body: body.to_string(),
+                load_factor: records.last().map_or(0.0, |r| r.load_factor),
+                member: member + 1,
+            },
+            breaks: records
+                .iter()
+                .map(|r| SummaryBreak {
+                    step,
+                    body: body.to_string(),
+                    member: r.member,
+                    load_factor: r.load_factor,
+                    tooth: r.tooth,
+                })
+                .collect(),
+        }
+    }
+
     /// The written form of breaks of `step`: 1-based members, the step's fractions of its
     /// load increment turned into load factors.
     fn break_records(&self, breaks: &[BreakEvent], step: usize) -> Vec<BreakRecord> {
@@ -217,6 +267,7 @@ impl<'w> Simulation<'w> {
             .map(|b| BreakRecord {
                 member: b.member + 1,
                 load_factor: from + b.fraction * (to - from),
+                tooth: b.tooth,
             })
             .collect()
     }

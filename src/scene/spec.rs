@@ -160,6 +160,18 @@ pub struct MaterialSpec {
     pub failure: Option<String>,
     /// `{ weibull_modulus, seed }`: each breaking member's strength drawn from a Weibull law.
     pub scatter: Option<ScatterSpec>,
+    /// `{ fracture_energy, teeth }`: saw-tooth softening of breaking members.
+    pub softening: Option<SofteningSpec>,
+}
+
+/// `softening = { fracture_energy = 100.0, teeth = 5 }` of a breaking material.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SofteningSpec {
+    /// Fracture energy G_f, J/m² over the member's cross-section.
+    pub fracture_energy: Real,
+    /// Teeth of the saw-tooth, ≥ 1 (1: brittle).
+    pub teeth: usize,
 }
 
 /// `scatter = { weibull_modulus = 12.0, seed = 7 }` of a breaking material.

@@ -10,11 +10,17 @@
 //! (Sherman–Morrison, with prescribed displacements too: `e` is the member's elongation,
 //! `w = K⁻¹ g`, `s = 1/k − gᵀ w`), so a break costs one solve with the factor, not a solve per
 //! pattern.
+//!
+//! A softening member (its material's `softening`, see [`saw_tooth`]) passes through its
+//! teeth the same way: each tooth is an event found like a break, and the drop of its
+//! stiffness from `kᵢ` to `kᵢ₊₁` is the rank-one removal of `(kᵢ − kᵢ₊₁) g gᵀ`; the last tooth
+//! breaks it.
 
 use crate::linalg::{CholeskyError, LowRankUpdate, SparseCholesky};
 use crate::linkage::body_state::{linear_internal_forces, linear_stretch, undeformed_axis};
 use crate::linkage::fracture::{
-    critical_fraction, member_limits, unsupported_pieces, BreakEvent, FallenPiece, FractureState,
+    critical_fraction, member_limits, saw_tooth, unsupported_pieces, BreakEvent, FallenPiece,
+    FractureState, Tooth,
 };
 use crate::linkage::load_patterns::{solve_load_patterns, LoadPattern};
 use crate::linkage::mechanism::diagnose_mechanism;
@@ -58,8 +64,19 @@ pub struct BreakingEquilibrium {
     values: Vec<Real>,
     cholesky: Option<SparseCholesky>,
     update: LowRankUpdate,
-    /// Per member `A E / L`, N/m; 0 once broken or fallen off.
+    /// Per member its current `A Eᵢ / L`, N/m; 0 once broken or fallen off.
     stiffness: Vec<Real>,
+    /// Per member `A E / L` of its material, N/m.
+    full_stiffness: Vec<Real>,
+    /// Per member its Young's modulus as a fraction of its material's (its tooth's; 1 for a
+    /// member that does not soften).
+    modulus_factor: Vec<Real>,
+    /// Per softening member its teeth; empty for the others.
+    teeth: Vec<Vec<Tooth>>,
+    /// Per member the index of its current tooth.
+    tooth: Vec<usize>,
+    /// Per member its first tooth's strengths (tensile, compressive), Pa.
+    first_limits: MemberLimits,
     axes: Vec<Vector3<Real>>,
     /// Per member its undeformed length, m.
     lengths: Vec<Real>,
@@ -86,6 +103,7 @@ impl BreakingEquilibrium {
     /// Pa; `None`: the member does not break), e.g. drawn with scatter.
     pub fn with_limits(body: &Body, limits: MemberLimits) -> Result<Self, SolveError> {
         body.validate()?;
+        let teeth = member_teeth(body, &limits)?;
         let t = Instant::now();
         let dofs = DofMap::new(body);
         let assembly = StiffnessAssembly::new(body, &dofs)?;
@@ -112,7 +130,12 @@ impl BreakingEquilibrium {
             values: Vec::new(),
             cholesky: None,
             update: LowRankUpdate::new(n, SINGULAR_RATIO),
+            full_stiffness: stiffness.clone(),
             stiffness,
+            modulus_factor: vec![1.0; body.members.len()],
+            teeth,
+            tooth: vec![0; body.members.len()],
+            first_limits: limits.clone(),
             axes,
             lengths,
             limits,
@@ -307,7 +330,8 @@ impl BreakingEquilibrium {
                 let stress = |u: &[Real]| {
                     let strain =
                         linear_stretch(u, d, member.nodes, &self.axes[m]) / self.lengths[m];
-                    material.youngs_modulus * strain * material.area / material.area
+                    material.youngs_modulus * self.modulus_factor[m] * strain * material.area
+                        / material.area
                 };
                 let end = stress(&u1);
                 if end <= tensile && end >= -compressive {
@@ -324,6 +348,7 @@ impl BreakingEquilibrium {
                     best = Some(BreakEvent {
                         member: m,
                         fraction: t,
+                        tooth: None,
                     });
                 }
             }
@@ -331,12 +356,22 @@ impl BreakingEquilibrium {
         best
     }
 
-    /// Break member `m`: correct every pattern's solution, or, when the break leaves `K_ff`
-    /// singular, remove the pieces it left unsupported (returned) and refactor. `Err(())` when
-    /// the supported part itself is a mechanism.
-    fn break_member(&mut self, body: &Body, m: usize) -> Result<Vec<FallenPiece>, ()> {
+    /// Member `m` reached its strength: move it to its next tooth (returned, 1-based: the
+    /// tooth it passed) when it has one, else break it. Either way every pattern's solution is
+    /// corrected; when a break leaves `K_ff` singular the pieces it left unsupported are
+    /// removed (returned) and `K_ff` refactored. `Err(())` when the supported part itself is a
+    /// mechanism.
+    #[allow(clippy::type_complexity)]
+    fn break_member(
+        &mut self,
+        body: &Body,
+        m: usize,
+    ) -> Result<(Option<usize>, Vec<FallenPiece>), ()> {
         let d = self.dofs.dofs_per_node;
-        let k = self.stiffness[m];
+        let next = self.tooth[m] + 1;
+        let softened = self.teeth[m].get(next).copied();
+        let k_after = softened.map_or(0.0, |t| self.full_stiffness[m] * t.stiffness_factor);
+        let k = self.stiffness[m] - k_after;
         let mut g = Vec::with_capacity(2 * d);
         for (sign, &node) in [-1.0, 1.0].iter().zip(&body.members[m].nodes) {
             for dir in 0..d {
@@ -346,7 +381,18 @@ impl BreakingEquilibrium {
             }
         }
         let elongations = self.elongations(body, m);
-        self.broken.push(m);
+        if let Some(t) = softened {
+            self.tooth[m] = next;
+            self.modulus_factor[m] = t.stiffness_factor;
+            let (tensile, compressive) = self.first_limits[m].unwrap_or((1.0, 1.0));
+            self.limits[m] = Some((
+                t.tensile_strength,
+                compressive * (t.tensile_strength / tensile),
+            ));
+        } else {
+            self.broken.push(m);
+        }
+        let passed = softened.map(|_| next);
         let t = Instant::now();
         let removal = match self.cholesky.as_mut() {
             Some(c) if !g.is_empty() => self
@@ -356,7 +402,7 @@ impl BreakingEquilibrium {
             _ => Ok(None),
         };
         self.times.solve += t.elapsed().as_secs_f64();
-        self.stiffness[m] = 0.0;
+        self.stiffness[m] = k_after;
         match removal {
             Ok(Some(r)) => {
                 for (p, e) in self.patterns.iter_mut().zip(&elongations) {
@@ -368,9 +414,17 @@ impl BreakingEquilibrium {
                 if self.update.rank() >= self.refactor_every && !self.refactor(body) {
                     return Err(());
                 }
-                Ok(Vec::new())
+                Ok((passed, Vec::new()))
             }
-            Ok(None) => Ok(Vec::new()),
+            Ok(None) => Ok((passed, Vec::new())),
+            // A tooth leaves the member some stiffness: a drop so large that K_ff looks
+            // singular to the update is taken as it is, by refactoring.
+            Err(_) if passed.is_some() => {
+                if !self.refactor(body) {
+                    return Err(());
+                }
+                Ok((passed, Vec::new()))
+            }
             Err(_) => {
                 let pieces = self.release_pieces(body);
                 if pieces.is_empty() {
@@ -379,10 +433,13 @@ impl BreakingEquilibrium {
                 if !self.refactor(body) {
                     return Err(());
                 }
-                Ok(pieces
-                    .into_iter()
-                    .map(|nodes| FallenPiece { member: m, nodes })
-                    .collect())
+                Ok((
+                    None,
+                    pieces
+                        .into_iter()
+                        .map(|nodes| FallenPiece { member: m, nodes })
+                        .collect(),
+                ))
             }
         }
     }
@@ -467,12 +524,13 @@ impl BreakingEquilibrium {
                 .collect()
         };
         let (f0, f1) = (factors(step - 1), factors(step));
-        let Some(event) = self.next_break(body, &f0, &f1) else {
+        let Some(mut event) = self.next_break(body, &f0, &f1) else {
             return Ok(None);
         };
         match self.break_member(body, event.member) {
-            Ok(pieces) => {
+            Ok((tooth, pieces)) => {
                 fallen.extend(pieces);
+                event.tooth = tooth;
                 Ok(Some(event))
             }
             Err(()) => Err(SolveError::Collapse {
@@ -531,7 +589,7 @@ impl BreakingEquilibrium {
             let strain = linear_stretch(&u, d, member.nodes, &self.axes[m]) / body.member_length(m);
             let material = &body.materials[member.material];
             let force = if self.stiffness[m] > 0.0 {
-                material.youngs_modulus * strain * material.area
+                material.youngs_modulus * self.modulus_factor[m] * strain * material.area
             } else {
                 0.0
             };
@@ -556,6 +614,39 @@ impl BreakingEquilibrium {
         }
         Ok(state)
     }
+}
+
+/// Per member its teeth when its material softens (from its first tooth's tensile strength in
+/// `limits`, scattered or not), else none.
+pub fn member_teeth(body: &Body, limits: &MemberLimits) -> Result<Vec<Vec<Tooth>>, SolveError> {
+    body.members
+        .iter()
+        .enumerate()
+        .map(|(m, member)| {
+            let material = &body.materials[member.material];
+            let (Some(softening), Some((tensile, _))) = (material.softening, limits[m]) else {
+                return Ok(Vec::new());
+            };
+            if !tensile.is_finite() {
+                return Ok(Vec::new());
+            }
+            let length = body.member_length(m);
+            saw_tooth(
+                material.youngs_modulus,
+                tensile,
+                length,
+                softening.fracture_energy,
+                softening.teeth,
+            )
+            .map_err(|least| SolveError::SofteningTooBrittle {
+                body: body.name.clone(),
+                member: m,
+                fracture_energy: softening.fracture_energy,
+                least,
+                length,
+            })
+        })
+        .collect()
 }
 
 fn factorization_error(body: &Body, e: CholeskyError) -> SolveError {

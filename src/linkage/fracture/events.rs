@@ -3,7 +3,7 @@
 use crate::linkage::{Body, Failure};
 use crate::Real;
 
-/// One member breaking during a load step.
+/// One member breaking, or softening by a tooth, during a load step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BreakEvent {
     /// The member, 0-based.
@@ -12,6 +12,10 @@ pub struct BreakEvent {
     /// (and prescribed displacements likewise), `t ≤ 1`; `t` below the previous break's is a
     /// snap-back (the structure, weakened, failed at a lower load).
     pub fraction: Real,
+    /// `Some(k)`: the member did not break but passed its tooth `k` (1-based, below its
+    /// material's `softening.teeth`), its stiffness and strength dropping to tooth `k + 1`'s;
+    /// `None`: it broke (past its last tooth, or brittle).
+    pub tooth: Option<usize>,
 }
 
 /// A piece left without support by a break: removed from the solve (it fell off).
@@ -28,7 +32,7 @@ pub struct FallenPiece {
 pub struct FractureState {
     /// Members broken so far (this step included), 0-based, in the order they broke.
     pub broken: Vec<usize>,
-    /// The breaks of this step, in order.
+    /// The breaks of this step, and the teeth softening members passed, in order.
     pub breaks: Vec<BreakEvent>,
     /// Pieces that fell off during this step.
     pub fallen: Vec<FallenPiece>,

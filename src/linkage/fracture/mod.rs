@@ -1,13 +1,17 @@
-//! Members that break (sequentially linear analysis, event by event): the critical load of a member, pieces that fall off, and the linear solver that breaks members without refactoring.
+//! Members that break (sequentially linear analysis, event by event): the critical load of a member, its saw-tooth softening, pieces that fall off, and the linear solver that breaks members without refactoring.
 
-pub use self::breaking_equilibrium::{BreakingEquilibrium, MemberLimits, DEFAULT_REFACTOR_EVERY};
+pub use self::breaking_equilibrium::{
+    member_teeth, BreakingEquilibrium, MemberLimits, DEFAULT_REFACTOR_EVERY,
+};
 pub use self::critical::critical_fraction;
 pub use self::events::{breaks_members, BreakEvent, FallenPiece, FractureState};
 pub use self::pieces::unsupported_pieces;
 pub use self::scatter::{member_limits, weibull_factors};
+pub use self::softening::{saw_tooth, saw_tooth_dissipation, Tooth};
 
 mod breaking_equilibrium;
 mod critical;
 mod events;
 mod pieces;
 mod scatter;
+mod softening;

@@ -1,0 +1,377 @@
+//! Members that break (or soften by teeth) in a scene with contact, event by event.
+//!
+//! Contact makes the response to the load nonlinear (the contact set changes with it), so the
+//! critical load of a member is not one linear solve away. Within a step the bodies are first
+//! settled at the step's load. When a breaking member is then beyond its strength, the load at
+//! which the first one reaches it is found between the last settled state below it and the
+//! step's end: the secant of the members' stresses between the two states gives a candidate
+//! load (exact when the contact set does not change between them: linear bodies on a fixed
+//! contact set respond linearly to the loads, support displacements and obstacle travel);
+//! contact is settled there, and the bracket narrowed, until the member is at its strength to
+//! [`AT_STRENGTH`]. The member breaks (or passes a tooth) at that load, contact is settled
+//! again there with the weakened body, then at the step's load, and so on until no member is
+//! beyond its strength at the step's load. Members break only at settled states. A member
+//! already beyond its strength just after a break breaks at that break's load (a snap-back
+//! below it is not followed, unlike [`BreakingEquilibrium`](crate::linkage::fracture::BreakingEquilibrium)).
+//!
+//! A broken member keeps its place in the body with a copy of its material of zero modulus (a
+//! softened one: of its tooth's modulus), so numbering, patterns and surfaces stay. Contact
+//! is solved on the coupled path for a scene with breaking bodies: the condensed path factors
+//! each body once per run, and a break changes its compliance. A break after which contact
+//! cannot be settled (a piece no support or contact holds, or the structure a mechanism) is the
+//! structure's collapse.
+
+use crate::contact::{ContactError, ContactSolver, ContactStep, Obstacle};
+use crate::linkage::body_state::{linear_stretch, undeformed_axis};
+use crate::linkage::fracture::{
+    breaks_members, critical_fraction, member_limits, BreakEvent, FractureState, MemberLimits,
+    Tooth,
+};
+use crate::linkage::{Body, SolveError};
+use crate::Real;
+use nalgebra::Vector3;
+
+/// A member counts as at its strength within this fraction of it (the contact Newton's
+/// residual of 1e-10 leaves the stresses accurate to about this).
+pub const AT_STRENGTH: Real = 1e-8;
+
+/// Settles allowed to find one critical load.
+const MAX_REFINEMENTS: usize = 60;
+
+/// One breaking body's members: strengths, teeth and what has broken.
+struct Breaking {
+    limits: MemberLimits,
+    first_limits: MemberLimits,
+    teeth: Vec<Vec<Tooth>>,
+    tooth: Vec<usize>,
+    /// Per member its modulus as a fraction of its material's (0 once broken).
+    factor: Vec<Real>,
+    axes: Vec<Vector3<Real>>,
+    lengths: Vec<Real>,
+    broken: Vec<usize>,
+}
+
+/// Why a step with breaking members stopped.
+#[derive(Debug)]
+pub enum FractureStop {
+    /// Contact could not be solved (before any break of the step that explains it).
+    Contact(ContactError),
+    /// A break left contact unable to hold the body: its collapse.
+    Collapse {
+        /// Body index.
+        body: usize,
+        /// The member (0-based) whose break did it.
+        member: usize,
+        /// The breaks of that body in the step, the last one included.
+        breaks: Vec<BreakEvent>,
+    },
+}
+
+impl From<ContactError> for FractureStop {
+    fn from(e: ContactError) -> Self {
+        FractureStop::Contact(e)
+    }
+}
+
+/// The bodies of a contact scene as they break, and each breaking body's members.
+pub struct ContactFracture {
+    /// The bodies as they are now (broken members of zero modulus).
+    pub bodies: Vec<Body>,
+    original: Vec<Body>,
+    breaking: Vec<Option<Breaking>>,
+    /// Per breaking body its members' stresses (Pa) at the end of the last step solved.
+    last: Vec<Vec<Real>>,
+    /// The pseudo-time of the solver's current state.
+    now: Real,
+}
+
+impl ContactFracture {
+    /// The breaking state of `bodies` (each member's strength drawn with its scatter, its
+    /// teeth with its softening); `None` when no body breaks.
+    pub fn new(bodies: &[Body]) -> Result<Option<Self>, SolveError> {
+        if !bodies.iter().any(breaks_members) {
+            return Ok(None);
+        }
+        let breaking = bodies
+            .iter()
+            .map(|body| {
+                if !breaks_members(body) {
+                    return Ok(None);
+                }
+                let limits = member_limits(body);
+                let teeth = crate::linkage::fracture::member_teeth(body, &limits)?;
+                let n = body.members.len();
+                Ok(Some(Breaking {
+                    first_limits: limits.clone(),
+                    limits,
+                    teeth,
+                    tooth: vec![0; n],
+                    factor: vec![1.0; n],
+                    axes: body
+                        .members
+                        .iter()
+                        .map(|m| undeformed_axis(body, m.nodes[0], m.nodes[1]))
+                        .collect(),
+                    lengths: (0..n).map(|m| body.member_length(m)).collect(),
+                    broken: Vec::new(),
+                }))
+            })
+            .collect::<Result<Vec<_>, SolveError>>()?;
+        Ok(Some(ContactFracture {
+            bodies: bodies.to_vec(),
+            original: bodies.to_vec(),
+            last: bodies.iter().map(|b| vec![0.0; b.members.len()]).collect(),
+            breaking,
+            now: 0.0,
+        }))
+    }
+
+    /// Every breaking member's stress at the solver's current displacements, Pa, per body
+    /// (empty for a body that does not break).
+    fn stresses(&self, solver: &ContactSolver) -> Vec<Vec<Real>> {
+        self.breaking
+            .iter()
+            .enumerate()
+            .map(|(b, br)| {
+                let Some(br) = br else { return Vec::new() };
+                let body = &self.original[b];
+                let u = &solver.parts[b].u;
+                let d = body.dimension.dofs_per_node();
+                body.members
+                    .iter()
+                    .enumerate()
+                    .map(|(m, member)| {
+                        let material = &body.materials[member.material];
+                        let strain =
+                            linear_stretch(u, d, member.nodes, &br.axes[m]) / br.lengths[m];
+                        material.youngs_modulus * br.factor[m] * strain * material.area
+                            / material.area
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The first member to reach its strength on the secant from stresses `lo` to `hi`: (body,
+    /// member, fraction of the way), the smallest fraction, ties by body then member. Members
+    /// beyond their strength by less than [`AT_STRENGTH`] at `hi` do not count.
+    fn first_over(&self, lo: &[Vec<Real>], hi: &[Vec<Real>]) -> Option<(usize, usize, Real)> {
+        let mut best: Option<(usize, usize, Real)> = None;
+        for (b, br) in self.breaking.iter().enumerate() {
+            let Some(br) = br else { continue };
+            for m in 0..br.factor.len() {
+                let Some((tensile, compressive)) = br.limits[m] else {
+                    continue;
+                };
+                if br.factor[m] == 0.0 {
+                    continue;
+                }
+                let (a, end) = (lo[b][m], hi[b][m]);
+                if end <= tensile * (1.0 + AT_STRENGTH) && end >= -compressive * (1.0 + AT_STRENGTH)
+                {
+                    continue;
+                }
+                if let Some(f) = critical_fraction(a, end - a, tensile, compressive) {
+                    if best.is_none_or(|(_, _, g)| f < g) {
+                        best = Some((b, m, f));
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Whether member `m` of body `b` is at its strength in `stress` to [`AT_STRENGTH`].
+    fn at_strength(&self, b: usize, m: usize, stress: &[Vec<Real>]) -> bool {
+        let Some(br) = &self.breaking[b] else {
+            return false;
+        };
+        let Some((tensile, compressive)) = br.limits[m] else {
+            return false;
+        };
+        let s = stress[b][m];
+        (s - tensile).abs() <= AT_STRENGTH * tensile
+            || (s + compressive).abs() <= AT_STRENGTH * compressive
+    }
+
+    /// Break member `m` of body `b`, or move it to its next tooth (returned, 1-based: the
+    /// tooth passed).
+    fn break_member(&mut self, b: usize, m: usize) -> Option<usize> {
+        let br = self.breaking[b].as_mut()?;
+        let next = br.tooth[m] + 1;
+        let body = &mut self.bodies[b];
+        let material = self.original[b].members[m].material;
+        let mut copy = self.original[b].materials[material].clone();
+        let passed = match br.teeth[m].get(next).copied() {
+            Some(t) => {
+                br.tooth[m] = next;
+                br.factor[m] = t.stiffness_factor;
+                let (tensile, compressive) = br.first_limits[m].unwrap_or((1.0, 1.0));
+                br.limits[m] = Some((
+                    t.tensile_strength,
+                    compressive * (t.tensile_strength / tensile),
+                ));
+                Some(next)
+            }
+            None => {
+                br.factor[m] = 0.0;
+                br.broken.push(m);
+                None
+            }
+        };
+        copy.youngs_modulus *= br.factor[m];
+        copy.name = format!("{} (member {})", copy.name, m + 1);
+        body.materials.push(copy);
+        body.members[m].material = body.materials.len() - 1;
+        passed
+    }
+
+    /// Settle contact at pseudo-time `t` from the solver's current state.
+    fn settle(
+        &mut self,
+        solver: &mut ContactSolver,
+        obstacles: &[Obstacle],
+        t: Real,
+        (step, steps): (usize, usize),
+    ) -> Result<(), ContactError> {
+        let from = self.now;
+        self.now = t;
+        solver
+            .settle_at(&self.bodies, obstacles, from, t, steps, step)
+            .map(|_| ())
+    }
+
+    /// Solve `step` of `steps` with `solver` (built on these bodies), breaking members event by
+    /// event (see the module documentation). Returns the step and, per body, its fracture state
+    /// (`None` for a body that does not break).
+    pub fn solve_step(
+        &mut self,
+        solver: &mut ContactSolver,
+        obstacles: &[Obstacle],
+        step: usize,
+        steps: usize,
+    ) -> Result<(ContactStep, Vec<Option<FractureState>>), FractureStop> {
+        if step == 0 {
+            self.bodies = self.original.clone();
+            let fresh = ContactFracture::new(&self.original)
+                .ok()
+                .flatten()
+                .map(|f| f.breaking);
+            if let Some(breaking) = fresh {
+                self.breaking = breaking;
+            }
+            for l in &mut self.last {
+                l.iter_mut().for_each(|v| *v = 0.0);
+            }
+        }
+        let mut out = solver.solve_step(&self.bodies, obstacles, step, steps)?;
+        self.now = step as Real;
+        let mut events: Vec<Vec<BreakEvent>> = vec![Vec::new(); self.bodies.len()];
+        if step > 0 {
+            let end = step as Real;
+            let (mut t_lo, mut lo) = (end - 1.0, self.last.clone());
+            let mut hi = self.stresses(solver);
+            while let Some((b, m, t_break)) =
+                self.critical_load(solver, obstacles, step, steps, (t_lo, &lo), &hi)?
+            {
+                let tooth = self.break_member(b, m);
+                events[b].push(BreakEvent {
+                    member: m,
+                    fraction: t_break - (end - 1.0),
+                    tooth,
+                });
+                let collapse = |events: &mut Vec<Vec<BreakEvent>>| FractureStop::Collapse {
+                    body: b,
+                    member: m,
+                    breaks: std::mem::take(&mut events[b]),
+                };
+                // The state just after the break, at its load, then at the step's.
+                if self
+                    .settle(solver, obstacles, t_break, (step, steps))
+                    .is_err()
+                {
+                    return Err(collapse(&mut events));
+                }
+                (t_lo, lo) = (t_break, self.stresses(solver));
+                if self.settle(solver, obstacles, end, (step, steps)).is_err() {
+                    return Err(collapse(&mut events));
+                }
+                hi = self.stresses(solver);
+            }
+            if events.iter().any(|e| !e.is_empty()) {
+                solver.restart_path();
+                out = solver.report(&self.bodies, obstacles, step, steps, out)?;
+            }
+        }
+        self.last = self.stresses(solver);
+        let states = self
+            .breaking
+            .iter()
+            .zip(events)
+            .map(|(br, breaks)| {
+                br.as_ref().map(|br| FractureState {
+                    broken: br.broken.clone(),
+                    breaks,
+                    fallen: Vec::new(),
+                })
+            })
+            .collect();
+        Ok((out, states))
+    }
+
+    /// The first member to reach its strength between the settled state at pseudo-time `t_lo`
+    /// (stresses `lo`, members within their strength) and the step's end (stresses `hi`, the
+    /// solver's current state): (body, member, pseudo-time), contact settled there; `None`
+    /// when every member is within its strength at the end.
+    #[allow(clippy::type_complexity)]
+    fn critical_load(
+        &mut self,
+        solver: &mut ContactSolver,
+        obstacles: &[Obstacle],
+        step: usize,
+        steps: usize,
+        (t_lo, lo): (Real, &[Vec<Real>]),
+        hi: &[Vec<Real>],
+    ) -> Result<Option<(usize, usize, Real)>, FractureStop> {
+        let end = step as Real;
+        let (mut t_lo, mut lo) = (t_lo, lo.to_vec());
+        let (mut t_hi, mut hi) = (end, hi.to_vec());
+        let Some(mut found) = self.first_over(&lo, &hi) else {
+            return Ok(None);
+        };
+        for _ in 0..MAX_REFINEMENTS {
+            let (b, m, f) = found;
+            if f <= 0.0 {
+                // Beyond its strength already where the bracket starts (just after a break).
+                self.settle(solver, obstacles, t_lo, (step, steps))?;
+                return Ok(Some((b, m, t_lo)));
+            }
+            let t = t_lo + f.min(1.0) * (t_hi - t_lo);
+            self.settle(solver, obstacles, t, (step, steps))?;
+            let at = self.stresses(solver);
+            match self.first_over(&lo, &at) {
+                // Someone beyond its strength at t: the crossing is before it.
+                Some(next) if !self.at_strength(next.0, next.1, &at) => {
+                    (t_hi, hi) = (t, at);
+                    found = self.first_over(&lo, &hi).unwrap_or(next);
+                }
+                _ if self.at_strength(b, m, &at) || t_hi - t_lo <= 1e-12 * end.max(1.0) => {
+                    return Ok(Some((b, m, t)));
+                }
+                _ => {
+                    (t_lo, lo) = (t, at);
+                    match self.first_over(&lo, &hi) {
+                        Some(next) => found = next,
+                        None => {
+                            self.settle(solver, obstacles, t_hi, (step, steps))?;
+                            return Ok(Some((b, m, t_hi)));
+                        }
+                    }
+                }
+            }
+        }
+        let (b, m, _) = found;
+        self.settle(solver, obstacles, t_hi, (step, steps))?;
+        Ok(Some((b, m, t_hi)))
+    }
+}
