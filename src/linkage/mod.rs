@@ -23,8 +23,8 @@ pub use self::member_stiffness::{
 pub use self::newton::NewtonEquilibrium;
 pub(crate) use self::newton::{lagrange_weights, IncrementSize};
 pub use self::pressure::{
-    chosen_patches, face_forces, load_stiffness_blocks, pressure_loads, pressure_loads_on,
-    symmetric_load_stiffness_blocks, Pressure, PressureFaces,
+    chosen_patches, face_forces, load_stiffness_blocks, load_stiffness_parts, pressure_loads,
+    pressure_loads_on, symmetric_load_stiffness_blocks, Pressure, PressureFaces,
 };
 pub use self::self_weight::self_weight_loads;
 pub use self::solver_choice::{

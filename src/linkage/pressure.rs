@@ -15,8 +15,9 @@
 //! sum is symmetric. The Newton tangent takes its symmetric part
 //! `S_ij = (p/12) [e_j − e_i]×` (3D) or `S_ab = −(p/2) R` (2D), zero on the diagonal blocks:
 //! exact, and Newton quadratic, on a closed surface (and wherever the skew rest acts only on
-//! supported directions); elsewhere the skew rest, which lives on the surface's rim, is left
-//! out and Newton converges linearly.
+//! supported directions: [`load_stiffness_parts`] tells). Elsewhere the skew rest, which lives
+//! on the surface's rim, is not small; the symmetric part alone can then slow Newton down, and
+//! the Newton solver leaves the load stiffness out (it converges linearly).
 
 use crate::linkage::{Body, NodalLoad, Schedule};
 use crate::Real;
@@ -174,6 +175,41 @@ pub fn symmetric_load_stiffness_blocks(
             }
         }
     }
+}
+
+/// The Frobenius norms (N/m) of the skew and of the symmetric part of the load stiffness of
+/// `pressures` (each `(faces, pressure)`) at `position`, over the entries whose row and column
+/// directions are both `free(node, direction)`: the tangent may take the symmetric part alone
+/// only where the skew part there vanishes (a closed surface, or a rim moving only in supported
+/// directions).
+pub fn load_stiffness_parts<'a>(
+    pressures: impl Iterator<Item = (&'a PressureFaces, Real)>,
+    position: impl Fn(usize) -> Vector3<Real> + Copy,
+    free: impl Fn(usize, usize) -> bool,
+) -> (Real, Real) {
+    let mut blocks: std::collections::HashMap<(usize, usize), Matrix3<Real>> =
+        std::collections::HashMap::new();
+    for (faces, pressure) in pressures {
+        load_stiffness_blocks(faces, pressure, position, |i, j, k| {
+            *blocks.entry((i, j)).or_insert_with(Matrix3::zeros) += k;
+        });
+    }
+    let (mut skew, mut symmetric) = (0.0, 0.0);
+    for (&(i, j), k) in &blocks {
+        let kt = blocks
+            .get(&(j, i))
+            .map_or(Matrix3::zeros(), |m| m.transpose());
+        let (a, s) = ((k - kt) * 0.5, (k + kt) * 0.5);
+        for p in 0..3 {
+            for q in 0..3 {
+                if free(i, p) && free(j, q) {
+                    skew += a[(p, q)] * a[(p, q)];
+                    symmetric += s[(p, q)] * s[(p, q)];
+                }
+            }
+        }
+    }
+    (skew.sqrt(), symmetric.sqrt())
 }
 
 /// The nodal loads of `pressure` on `faces` of the undeformed `body` (the pressure of a body

@@ -127,6 +127,10 @@ pub(crate) fn follower_forces(body: &Body, u: &[Real], t: Real, steps: usize, ou
     }
 }
 
+/// The skew part of the pressures' load stiffness on the free DOFs, relative to its symmetric
+/// part, below which the symmetric part is taken as the whole (round-off of a closed surface).
+const SYMMETRIC_LOAD_STIFFNESS: Real = 1e-8;
+
 /// Converged states kept for the extrapolation (three: up to a quadratic through them).
 const PATH_POINTS: usize = 3;
 
@@ -345,11 +349,26 @@ impl NewtonEquilibrium {
     }
 
     /// Add the symmetric part of the following pressures' load stiffness at the current
-    /// displacement (see [`crate::linkage::symmetric_load_stiffness_blocks`]): exact on a
-    /// closed surface under one pressure.
+    /// displacement (see [`crate::linkage::symmetric_load_stiffness_blocks`]) where it is the
+    /// whole of it on the free DOFs (a closed surface under one pressure, or a rim that moves
+    /// only in supported directions): Newton is then exact and quadratic. Elsewhere the skew
+    /// part is not small, the symmetric part alone can slow Newton down, and the tangent
+    /// leaves the load stiffness out (Newton converges linearly).
     fn add_load_stiffness(&mut self, body: &Body) {
         let d = body.dimension.dofs_per_node();
         let (t, steps) = self.follower_time;
+        let u = &self.u;
+        let slots = &self.dofs.slots;
+        let (skew, symmetric) = crate::linkage::load_stiffness_parts(
+            body.pressures
+                .iter()
+                .map(|p| (&p.faces, p.pressure * factor_at(&p.schedule, t, steps))),
+            |n| body.nodes[n] + node_vector(u, d, n),
+            |n, k| k < d && matches!(slots[n * d + k], crate::linkage::DofSlot::Free(_)),
+        );
+        if skew > SYMMETRIC_LOAD_STIFFNESS * symmetric {
+            return;
+        }
         for p in &body.pressures {
             let factor = factor_at(&p.schedule, t, steps);
             if factor == 0.0 {
