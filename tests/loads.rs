@@ -109,3 +109,127 @@ fn a_pressure_on_one_face_of_a_box_sums_to_p_times_its_area() {
         .to_string();
     assert!(e.contains("pressure") && e.contains("no patch"), "{e}");
 }
+
+#[test]
+fn gravity_follows_its_own_schedule_and_a_bad_one_is_named() {
+    let scheduled = SCENE.replace(
+        "gravity = [0.0, -9.81, 0.0]",
+        "gravity = [0.0, -9.81, 0.0]\ngravity_schedule = [1.0, 0.5]",
+    );
+    let world = build_world(&scheduled, Path::new("heavy_box.toml")).unwrap();
+    let body = &world.bodies[0];
+    assert!(!body.loads.is_empty());
+    for l in &body.loads {
+        assert_eq!(l.schedule.factor(1, 2), 1.0);
+        assert_eq!(l.schedule.factor(2, 2), 0.5);
+    }
+    let short = SCENE.replace(
+        "gravity = [0.0, -9.81, 0.0]",
+        "gravity = [0.0, -9.81, 0.0]\ngravity_schedule = [1.0]",
+    );
+    let e = build_world(&short, Path::new("heavy_box.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("gravity_schedule has 1 factors"), "{e}");
+    let alone = SCENE.replace(
+        "gravity = [0.0, -9.81, 0.0]",
+        "gravity_schedule = [1.0, 1.0]",
+    );
+    let e = build_world(&alone, Path::new("heavy_box.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("without gravity"), "{e}");
+}
+
+const PLATE: &str = r#"
+name = "pressed_plate"
+steps = 1
+
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+
+[[bodies]]
+name = "plate"
+rectangle = { width = 0.4, height = 0.2, cells = [4, 2] }
+
+[[bodies.supports]]
+on_line = { point = [0.0, 0.0], direction = [1.0, 0.0] }
+fix = ["x", "y"]
+
+[[bodies.pressures]]
+on_line = { point = [0.0, 0.2], direction = [1.0, 0.0] }
+pressure = 500.0
+schedule = [0.5]
+"#;
+
+#[test]
+fn a_2d_pressure_on_one_edge_sums_to_p_times_its_length_and_on_the_boundary_to_zero() {
+    // 500 N/m on the top edge, 0.4 m long: 200 N downward (into the plate), on the edge's 5
+    // nodes, with the pressure's own schedule.
+    let world = build_world(PLATE, Path::new("pressed_plate.toml")).unwrap();
+    let loads = &world.bodies[0].loads;
+    assert_eq!(loads.len(), 5);
+    let total: nalgebra::Vector3<f64> = loads.iter().map(|l| l.force).sum();
+    assert!((total.y + 200.0).abs() < 1e-12, "{total:?}");
+    assert!(total.x.abs() < 1e-12);
+    assert_eq!(loads[0].schedule.factor(1, 1), 0.5);
+    // The whole boundary (12 segments, the diagonals inside are not boundary): zero.
+    let all = PLATE.replace(
+        "on_line = { point = [0.0, 0.2], direction = [1.0, 0.0] }\npressure",
+        "inside = { min = [-1.0, -1.0], max = [1.0, 1.0] }\npressure",
+    );
+    let world = build_world(&all, Path::new("pressed_plate.toml")).unwrap();
+    let total: nalgebra::Vector3<f64> = world.bodies[0].loads.iter().map(|l| l.force).sum();
+    assert!(total.norm() < 1e-12, "a closed boundary: {total:?}");
+    // The corner node gets half of each of its two 0.1 m sides' 50 N, inward.
+    let corner = world.bodies[0].loads.iter().find(|l| l.node == 0).unwrap();
+    assert!(
+        (corner.force - nalgebra::Vector3::new(25.0, 25.0, 0.0)).norm() < 1e-12,
+        "{corner:?}"
+    );
+    // A line with no boundary segment on it: named.
+    let none = PLATE.replace("[0.0, 0.2], direction", "[0.0, 0.1], direction");
+    let e = build_world(&none, Path::new("pressed_plate.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no boundary segment"), "{e}");
+}
+
+#[test]
+fn a_large_body_keeps_its_pressure_following_and_a_contact_scene_refuses_it() {
+    let large = PLATE.replace(
+        "rectangle = { width = 0.4, height = 0.2, cells = [4, 2] }",
+        "rectangle = { width = 0.4, height = 0.2, cells = [4, 2] }\nkinematics = \"large\"",
+    );
+    let world = build_world(&large, Path::new("pressed_plate.toml")).unwrap();
+    let body = &world.bodies[0];
+    assert!(body.loads.is_empty());
+    assert_eq!(body.pressures.len(), 1);
+    assert_eq!(body.pressures[0].faces.len(), 4);
+    let out = tempfile::tempdir().unwrap();
+    // Solved: the step file's loads are the pressure's at half value on the deformed edge:
+    // their y parts sum to p/2 times the edge's deformed length along x (to round-off).
+    linkage::scene::run(&world, out.path(), &|| {}).unwrap();
+    let step: linkage::scene::StepResult = serde_json::from_slice(
+        &std::fs::read(out.path().join("pressed_plate/steps/0001.json")).unwrap(),
+    )
+    .unwrap();
+    let b = &step.bodies[0];
+    let total: f64 = b.loads.iter().map(|l| l.force[1]).sum();
+    let xs: Vec<f64> = b.loads.iter().map(|l| b.positions[l.node - 1][0]).collect();
+    let extent =
+        xs.iter().cloned().fold(f64::MIN, f64::max) - xs.iter().cloned().fold(f64::MAX, f64::min);
+    assert!((total + 250.0 * extent).abs() < 1e-9, "{total} {extent}");
+    assert!((total + 100.0).abs() < 1e-4, "{total}");
+    assert_eq!(step.bodies[0].loads.len(), 5);
+    let contact = format!(
+        "{large}\n[[obstacles]]\nname = \"floor\"\nshape = \"half_space\"\npoint = [0.0, -0.1]\nnormal = [0.0, 1.0]\n"
+    );
+    let world = build_world(&contact, Path::new("pressed_plate.toml")).unwrap();
+    let e = linkage::scene::run(&world, out.path(), &|| {})
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("follows the deformed faces"), "{e}");
+}

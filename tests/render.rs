@@ -32,6 +32,7 @@ fn square() -> (ModelFile, StepResult) {
                 node: 1,
                 fix: vec!["x".into(), "y".into()],
             }],
+            member_materials: Vec::new(),
         }],
     };
     let stresses = vec![5e6, -5e6, 9e6, 0.0];
@@ -166,6 +167,7 @@ fn two_patches() -> (ModelFile, StepResult) {
             members: vec![[1, 2], [2, 3], [3, 1], [4, 5], [5, 6], [6, 4]],
             patches: vec![[1, 2, 3], [4, 5, 6]],
             supports: vec![],
+            member_materials: Vec::new(),
         }],
     };
     let step = StepResult {

@@ -445,3 +445,38 @@ fn binary_and_ascii_files_carry_the_same_arrays() {
         sizes[1]
     );
 }
+
+#[test]
+fn each_member_carries_its_material_in_model_json_and_the_vtk_cells() {
+    // The composite beam: steel members and aluminium members in one body, named per member
+    // by the links file's third column.
+    let python = meshio_python();
+    let out = tempfile::tempdir().unwrap();
+    let world = load_scene(Path::new("scenes/composite_beam.toml")).unwrap();
+    let body = &world.bodies[0];
+    let names: Vec<&str> = body
+        .members
+        .iter()
+        .map(|m| body.materials[m.material].name.as_str())
+        .collect();
+    assert!(names.contains(&"steel") && names.contains(&"aluminium"));
+    let dir = run_with_vtk("scenes/composite_beam.toml", out.path());
+    let model: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("model.json")).unwrap()).unwrap();
+    let recorded: Vec<&str> = model["bodies"][0]["member_materials"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert_eq!(recorded, names);
+    // VTK: the number of the name in order of first appearance.
+    let first = names[0];
+    let v = read_vtu(&python, &dir.join("vtk/0005.vtu"));
+    let numbers = v["cell_data"]["material"][0].as_array().unwrap();
+    assert_eq!(numbers.len(), names.len());
+    for (n, name) in numbers.iter().zip(&names) {
+        let expected = if *name == first { 1 } else { 2 };
+        assert_eq!(n.as_i64().unwrap(), expected, "{name}");
+    }
+}

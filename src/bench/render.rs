@@ -42,6 +42,7 @@ pub fn bent_shell(rings: usize, sectors: usize) -> Result<(ModelFile, Vec<StepRe
                     fix: vec!["x".into(), "y".into(), "z".into()],
                 })
                 .collect(),
+            member_materials: Vec::new(),
         }],
     };
     let step = |k: usize, factor: Real| {

@@ -209,6 +209,18 @@ impl StiffnessAssembly {
         }
     }
 
+    /// Add to `values` a node block of `K_ff` between the two nodes of `member`: `block` has the
+    /// directions of the member's higher-numbered node as rows and those of its lower one as
+    /// columns (the transposed block above the diagonal is implied; in 2D only the upper-left
+    /// 2×2 is read).
+    pub fn add_pair_block(&self, member: usize, block: &Matrix3<Real>, values: &mut [Real]) {
+        for (k, &place) in self.cross[member].iter().enumerate() {
+            if place != NOT_FREE {
+                values[place as usize] += block[(k / 3, k % 3)];
+            }
+        }
+    }
+
     /// The place in the value array of `K_ff`'s diagonal entry of `node`'s direction `dir`,
     /// if that DOF is free (to hold a DOF that lost every member).
     pub fn diagonal_place(&self, node: usize, dir: usize) -> Option<usize> {

@@ -113,6 +113,10 @@ pub struct Body {
     pub supports: Vec<Support>,
     /// Applied nodal forces.
     pub loads: Vec<NodalLoad>,
+    /// Pressures that follow the deformation (large kinematics only, solved by Newton); a
+    /// pressure on a body under small displacements is given as `loads` instead
+    /// ([`crate::linkage::pressure_loads_on`]).
+    pub pressures: Vec<crate::linkage::Pressure>,
     /// Small (the paper's) or large displacements.
     pub kinematics: Kinematics,
     /// How a nonlinear body (large kinematics, or tension- or compression-only members) is solved.
@@ -427,7 +431,66 @@ impl Body {
             self.check_vector(&what, "force", &l.force)?;
             self.check_schedule(&what, &l.schedule)?;
         }
+        self.check_pressures()?;
         self.check_newton()
+    }
+
+    /// Following pressures: on a body under large displacements along a schedule path, on
+    /// faces of its dimension whose nodes exist and are joined by members (the load
+    /// stiffness goes into the members' places of the tangent).
+    fn check_pressures(&self) -> Result<(), BodyError> {
+        use crate::linkage::PressureFaces;
+        if self.pressures.is_empty() {
+            return Ok(());
+        }
+        let bad = |what: String, problem: String| BodyError::BadValue {
+            body: self.name.clone(),
+            what,
+            problem,
+        };
+        let mut pairs: Vec<(usize, usize)> = self
+            .members
+            .iter()
+            .map(|m| (m.nodes[0].min(m.nodes[1]), m.nodes[0].max(m.nodes[1])))
+            .collect();
+        pairs.sort_unstable();
+        for (k, p) in self.pressures.iter().enumerate() {
+            let what = format!("pressure {}", k + 1);
+            if self.kinematics != Kinematics::Large {
+                return Err(bad(what, "a pressure that follows the deformation needs kinematics = \"large\"; on a linear body give it as nodal loads on the undeformed faces (pressure_loads_on)".to_string()));
+            }
+            if self.newton.path != PathMethod::Schedules {
+                return Err(bad(what, "a pressure that follows the deformation is applied by its schedule, not along an arc length: use path = \"schedules\" or nodal loads".to_string()));
+            }
+            if !p.pressure.is_finite() {
+                return Err(bad(what, format!("pressure {} is not finite", p.pressure)));
+            }
+            let fits = matches!(
+                (&p.faces, self.dimension),
+                (PressureFaces::Patches(_), Dimension::Three)
+                    | (PressureFaces::Segments(_), Dimension::Two)
+            );
+            if !fits {
+                return Err(bad(
+                    what,
+                    "a 3D body takes pressure on patches, a 2D body on boundary segments"
+                        .to_string(),
+                ));
+            }
+            self.check_schedule(&what, &p.schedule)?;
+            for face in p.faces.nodes() {
+                for &n in face {
+                    self.check_target(&what, n)?;
+                }
+                for (i, &a) in face.iter().enumerate() {
+                    let b = face[(i + 1) % face.len()];
+                    if pairs.binary_search(&(a.min(b), a.max(b))).is_err() {
+                        return Err(bad(what, format!("nodes {} and {} of a loaded face are not joined by a member: a following pressure needs every edge of its faces to be a member (its load stiffness acts between their nodes)", a + 1, b + 1)));
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Whether this body needs the Newton solve: large kinematics, a path method other than the

@@ -49,6 +49,9 @@ pub struct NewtonSettings {
     pub max_cuts: usize,
     /// How the load path is followed.
     pub path: PathMethod,
+    /// Whether the tangent includes the load stiffness of pressures that follow the
+    /// deformation (default true; false only to compare convergence).
+    pub load_stiffness: bool,
 }
 
 impl Default for NewtonSettings {
@@ -59,6 +62,7 @@ impl Default for NewtonSettings {
             max_iterations: 30,
             max_cuts: 10,
             path: PathMethod::Schedules,
+            load_stiffness: true,
         }
     }
 }

@@ -7,6 +7,7 @@ pub use self::body::{
     NodalLoad, Schedule, Support,
 };
 pub use self::body_solver::BodySolver;
+pub use self::boundary_segments::boundary_segments;
 pub use self::convergence::{Convergence, NotFinite};
 pub use self::dof_map::{direction_name, DofMap, DofSlot};
 pub use self::equilibrium::{Equilibrium, PhaseTimes, SolveError};
@@ -21,7 +22,10 @@ pub use self::member_stiffness::{
 };
 pub use self::newton::NewtonEquilibrium;
 pub(crate) use self::newton::{lagrange_weights, IncrementSize};
-pub use self::pressure::pressure_loads;
+pub use self::pressure::{
+    chosen_patches, face_forces, load_stiffness_blocks, load_stiffness_parts, pressure_loads,
+    pressure_loads_on, symmetric_load_stiffness_blocks, Pressure, PressureFaces,
+};
 pub use self::self_weight::self_weight_loads;
 pub use self::solver_choice::{
     IterativeSettings, SolverChoice, SolverSettings, SolverUsed, AUTO_CONTACT_ITERATIVE_DOFS_3D,
@@ -34,6 +38,7 @@ mod assembly;
 mod body;
 mod body_solver;
 pub mod body_state;
+mod boundary_segments;
 mod convergence;
 mod dof_map;
 mod equilibrium;

@@ -96,6 +96,11 @@ pub(crate) fn post_process(
     for l in &body.loads {
         loaded[l.node] = true;
     }
+    for p in &body.pressures {
+        for face in p.faces.nodes() {
+            face.iter().for_each(|&n| loaded[n] = true);
+        }
+    }
     for (node, _) in loaded.iter().enumerate().filter(|(_, l)| **l) {
         let mut f = Vector3::zeros();
         for k in 0..d {

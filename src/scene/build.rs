@@ -303,13 +303,18 @@ fn densities(
 }
 
 /// The scene's `gravity` on `body`'s members of a material with a density, as nodal loads
-/// on the linear schedule (full weight at the last step).
+/// on `gravity_schedule` (default: linear, full weight at the last step).
 fn add_self_weight(
     body: &mut Body,
     spec: &SceneSpec,
     density: &[Option<crate::Real>],
 ) -> Result<(), String> {
     let Some(g) = &spec.gravity else {
+        if spec.gravity_schedule.is_some() {
+            return Err(
+                "gravity_schedule is given without gravity: add gravity = [...] (m/s²)".to_string(),
+            );
+        }
         return Ok(());
     };
     let g =
@@ -317,7 +322,21 @@ fn add_self_weight(
     if g.iter().any(|v| !v.is_finite()) {
         return Err(format!("gravity = {g:?}: give finite numbers in m/s²"));
     }
-    let loads = crate::linkage::self_weight_loads(body, density, g, &Schedule::Linear);
+    let schedule = match &spec.gravity_schedule {
+        None => Schedule::Linear,
+        Some(f) if f.len() != spec.steps => {
+            return Err(format!(
+            "gravity_schedule has {} factors but the scene has {} steps: give one factor per step",
+            f.len(),
+            spec.steps
+        ))
+        }
+        Some(f) if f.iter().any(|v| !v.is_finite()) => {
+            return Err(format!("gravity_schedule = {f:?}: give finite factors"))
+        }
+        Some(f) => Schedule::Factors(f.clone()),
+    };
+    let loads = crate::linkage::self_weight_loads(body, density, g, &schedule);
     body.loads.extend(loads);
     Ok(())
 }

@@ -34,6 +34,10 @@ pub struct ModelBody {
     pub patches: Vec<[usize; 3]>,
     /// Supported nodes, by node number.
     pub supports: Vec<SupportedNode>,
+    /// The name of each member's material (a `[[materials]]` name), in member order (empty in
+    /// files of older runs).
+    #[serde(default)]
+    pub member_materials: Vec<String>,
 }
 
 /// One rigid obstacle of `model.json`: its surface at step 0 and its translation per step.
@@ -164,6 +168,11 @@ impl ModelFile {
                         .map(|p| p.map(|n| n + 1))
                         .collect(),
                     supports,
+                    member_materials: b
+                        .members
+                        .iter()
+                        .map(|m| b.materials[m.material].name.clone())
+                        .collect(),
                 }
             })
             .collect();
@@ -221,6 +230,14 @@ impl ModelFile {
                     "body '{}': patch {} names a node outside 1..={n}",
                     b.name,
                     p + 1
+                ));
+            }
+            if !b.member_materials.is_empty() && b.member_materials.len() != b.members.len() {
+                return Some(format!(
+                    "body '{}': {} member materials for {} members",
+                    b.name,
+                    b.member_materials.len(),
+                    b.members.len()
                 ));
             }
             if let Some(s) = b.supports.iter().find(|s| bad(s.node)) {

@@ -154,6 +154,11 @@ impl<'a> NpzIn<'a> {
             .map_err(|e| format!("not a NumPy .npz archive ({e})"))
     }
 
+    /// Whether the archive holds array `name`.
+    pub(crate) fn contains(&mut self, name: &str) -> bool {
+        self.zip.by_name(&format!("{name}.npy")).is_ok()
+    }
+
     /// Array `name` of element type `T` (what the dtype must decode to).
     fn read<T: npyz::Deserialize>(&mut self, name: &str) -> Result<Array<T>, String> {
         let bad = |what: String| format!("array '{name}': {what}");

@@ -264,7 +264,8 @@ pub(crate) fn read_step_npz(bytes: &[u8], model: &ModelFile) -> Result<StepResul
 
 /// The bytes of `model.npz` of `model`: `scene`, `bodies` (names), per body `body<k>_dimension`,
 /// `_nodes` (n × d), `_members` (m × 2, 1-based), `_patches` (p × 3, 1-based), `_supports_node`
-/// (1-based) and `_supports_fix` (bool, s × d: x, y(, z) held); `obstacles` (names) and per
+/// (1-based), `_supports_fix` (bool, s × d: x, y(, z) held) and `_member_materials` (m, the
+/// name of each member's material); `obstacles` (names) and per
 /// obstacle `obstacle<k>_vertices` (v × 3), `_triangles` (t × 3, 1-based), `_offsets`
 /// ((steps + 1) × 3).
 pub(crate) fn model_npz(model: &ModelFile) -> std::io::Result<Vec<u8>> {
@@ -295,6 +296,8 @@ pub(crate) fn model_npz(model: &ModelFile) -> std::io::Result<Vec<u8>> {
             s.iter()
                 .flat_map(|s| AXES[..d].iter().map(|a| s.fix.iter().any(|f| f == a))),
         )?;
+        let materials: Vec<&str> = b.member_materials.iter().map(|m| m.as_str()).collect();
+        out.strs(&key("member_materials"), &[materials.len()], &materials)?;
     }
     let names: Vec<&str> = model.obstacles.iter().map(|o| o.name.as_str()).collect();
     out.strs("obstacles", &[names.len()], &names)?;
@@ -379,6 +382,13 @@ pub(crate) fn read_model_npz(bytes: &[u8]) -> Result<ModelFile, String> {
                     .collect(),
             })
             .collect();
+        // Absent in archives of older runs.
+        let member_materials = if npz.contains(&key("member_materials")) {
+            npz.strings(&key("member_materials"))?
+                .list(&key("member_materials"), None)?
+        } else {
+            Vec::new()
+        };
         bodies.push(ModelBody {
             name,
             dimension,
@@ -386,6 +396,7 @@ pub(crate) fn read_model_npz(bytes: &[u8]) -> Result<ModelFile, String> {
             members,
             patches,
             supports,
+            member_materials,
         });
     }
     let names = npz.strings("obstacles")?.list("obstacles", None)?;
@@ -430,6 +441,7 @@ mod tests {
                         node: 1,
                         fix: vec!["x".into(), "y".into()],
                     }],
+                    member_materials: vec!["steel".into()],
                 },
                 ModelBody {
                     name: "3d".into(),
@@ -441,6 +453,7 @@ mod tests {
                         node: 3,
                         fix: vec!["z".into()],
                     }],
+                    member_materials: vec!["a".into(), "b".into(), "a".into()],
                 },
             ],
             obstacles: vec![ModelObstacle {

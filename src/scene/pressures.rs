@@ -1,22 +1,26 @@
-//! `[[bodies.pressures]]`: pressure on the patches whose three nodes a selector chooses.
+//! `[[bodies.pressures]]`: pressure on the patches (3D) or boundary segments (2D) whose nodes a
+//! selector chooses; on the undeformed faces of a linear body, following the deformed ones
+//! of a body under large displacements.
 
-use crate::linkage::{pressure_loads, Body, Dimension, Schedule};
+use crate::linkage::{
+    boundary_segments, chosen_patches, pressure_loads_on, Body, Dimension, Kinematics, Pressure,
+    PressureFaces, Schedule,
+};
 use crate::scene::select_nodes;
 use crate::scene::spec::PressureSpec;
 
-/// Add the loads of `spec` (Pa on the chosen patches) to `body`, growing by `schedule`; errors
-/// say what to change.
+/// Add the pressure of `spec` (Pa on the chosen patches, N/m on the chosen 2D boundary
+/// segments) to `body`, growing by `schedule`: as nodal loads on the undeformed faces for a
+/// linear body, as a following [`Pressure`] for a body under large displacements. Errors say
+/// what to change.
 pub(crate) fn add_pressure(
     body: &mut Body,
     spec: &PressureSpec,
     schedule: Schedule,
 ) -> Result<(), String> {
-    if body.dimension == Dimension::Two {
-        return Err("pressure acts on patches, which 2D bodies do not have (pressure on 2D boundary segments is not available yet): apply `[[bodies.loads]]` instead".to_string());
-    }
     if !spec.pressure.is_finite() {
         return Err(format!(
-            "pressure = {}: give a finite pressure in Pa",
+            "pressure = {}: give a finite pressure (Pa in 3D, N/m in 2D)",
             spec.pressure
         ));
     }
@@ -25,10 +29,25 @@ pub(crate) fn add_pressure(
     for n in nodes {
         chosen[n] = true;
     }
-    let loads = pressure_loads(body, &chosen, spec.pressure, &schedule);
-    if loads.is_empty() {
-        return Err("no patch has all three of its nodes among the selected ones: select the nodes of whole surface triangles (e.g. `on_plane` on a face)".to_string());
+    let faces = match body.dimension {
+        Dimension::Three => PressureFaces::Patches(chosen_patches(body, &chosen)),
+        Dimension::Two => PressureFaces::Segments(boundary_segments(body, &chosen)),
+    };
+    if faces.is_empty() {
+        return Err(match body.dimension {
+            Dimension::Three => "no patch has all three of its nodes among the selected ones: select the nodes of whole surface triangles (e.g. `on_plane` on a face)".to_string(),
+            Dimension::Two => "no boundary segment (a member with the body on one side) has both of its nodes among the selected ones: select the nodes of whole boundary segments (e.g. `on_line` along an edge)".to_string(),
+        });
     }
-    body.loads.extend(loads);
+    if body.kinematics == Kinematics::Large {
+        body.pressures.push(Pressure {
+            pressure: spec.pressure,
+            faces,
+            schedule,
+        });
+    } else {
+        let loads = pressure_loads_on(body, &faces, spec.pressure, &schedule);
+        body.loads.extend(loads);
+    }
     Ok(())
 }

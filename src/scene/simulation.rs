@@ -59,6 +59,14 @@ impl<'w> Simulation<'w> {
                     ));
                 }
             }
+            if let Some(body) = world.bodies.iter().find(|b| !b.pressures.is_empty()) {
+                return Err(RunError::Solve {
+                    scene: world.source.clone(),
+                    source: SolveError::PressureUnsupported {
+                        body: body.name.clone(),
+                    },
+                });
+            }
         }
         let solver = if world.has_contact() {
             let contact =

@@ -34,6 +34,9 @@ pub struct SceneSpec {
     /// Acceleration of gravity, m/s² (one component per dimension): the self-weight of
     /// members whose material has a `density`, lumped to their end nodes.
     pub gravity: Option<Vec<Real>>,
+    /// Factor of `gravity` per step 1..=steps (default: linear ramp, full weight at the last
+    /// step), as a load's `schedule`.
+    pub gravity_schedule: Option<Vec<Real>>,
 }
 
 /// `[contact]`: penalty and tolerances (see `docs/SCENES.md`).

@@ -7,8 +7,10 @@
 //! `displacement`, `applied_force`, `reaction`, `contact_force`, `tangential_force` (its
 //! friction part; 3 components, m or N), `contact_state` (0 no contact, 1 sticking, 2
 //! slipping; frictionless contacts slip) and `body` (1-based). Cell data: `axial_force` (N),
-//! `stress` (Pa), `overloaded` (0/1), `member` (1-based, 0 on triangles) and `body`; with
-//! breaking members also `broken` (0/1, 0 on triangles). A triangle carries the mean axial
+//! `stress` (Pa), `overloaded` (0/1), `member` (1-based, 0 on triangles), `body` and
+//! `material` (the member's material: 1-based number of its name among the distinct names of
+//! `model.json`'s `member_materials`, body after body, in order of first appearance; 0 on
+//! triangles); with breaking members also `broken` (0/1, 0 on triangles). A triangle carries the mean axial
 //! force and
 //! stress of those of its three edges that are members (0 if none) and `overloaded` = 0.
 //!
@@ -141,6 +143,8 @@ struct Cell {
     broken: u8,
     member: usize,
     body: usize,
+    /// 1-based number of the member's material name (0 on triangles).
+    material: usize,
 }
 
 /// A per-node 3-vector array of one body from a list of (1-based node, force) entries.
@@ -183,6 +187,7 @@ pub(crate) fn vtu_file(
     let mut point_body = Vec::new();
     let mut lines: Vec<Cell> = Vec::new();
     let mut triangles = Vec::new();
+    let mut material_names: Vec<&str> = Vec::new();
     for (k, (m, r)) in bodies.iter().zip(&result.bodies).enumerate() {
         let base = points.len();
         let n = m.nodes.len();
@@ -215,6 +220,16 @@ pub(crate) fn vtu_file(
         let mut member_of: HashMap<(usize, usize), usize> = HashMap::new();
         for (j, e) in m.members.iter().enumerate() {
             member_of.insert((e[0].min(e[1]), e[0].max(e[1])), j);
+            let material = match m.member_materials.get(j) {
+                Some(name) => match material_names.iter().position(|n| n == name) {
+                    Some(i) => i + 1,
+                    None => {
+                        material_names.push(name);
+                        material_names.len()
+                    }
+                },
+                None => 0,
+            };
             lines.push(Cell {
                 points: vec![base + e[0] - 1, base + e[1] - 1],
                 kind: 3,
@@ -224,6 +239,7 @@ pub(crate) fn vtu_file(
                 broken: broken[j],
                 member: j + 1,
                 body: k + 1,
+                material,
             });
         }
         for p in &m.patches {
@@ -248,6 +264,7 @@ pub(crate) fn vtu_file(
                 broken: 0,
                 member: 0,
                 body: k + 1,
+                material: 0,
             });
         }
     }
@@ -282,6 +299,7 @@ pub(crate) fn vtu_file(
     }
     a.ints("member", cells.iter().map(|c| c.member));
     a.ints("body", cells.iter().map(|c| c.body));
+    a.ints("material", cells.iter().map(|c| c.material));
     a.xml.push_str("      </CellData>\n      <Points>\n");
     a.vectors("Points", &points);
     a.xml.push_str("      </Points>\n      <Cells>\n");

@@ -65,8 +65,13 @@ impl NewtonEquilibrium {
         let nd = body.dof_count();
         let forces = self.forces_at(body, t1, steps);
         let prescribed = prescribed_at(body, t1, steps);
+        self.follower_time = (t1, steps);
+        if !body.pressures.is_empty() {
+            super::follower_forces(body, &self.u, t1, steps, &mut self.follower);
+        }
+        let reference = norm(&self.applied(&forces));
         if let Some(s) = self.solver.as_mut() {
-            s.set_reference(norm(&forces));
+            s.set_reference(reference);
         }
         let mut convergence = Convergence::new(settings.tolerance);
         let mut internal = vec![0.0; nd];
@@ -88,7 +93,8 @@ impl NewtonEquilibrium {
         };
         loop {
             let r = self.out_of_balance(body, &forces, &mut internal);
-            let scale = force_scale(&self.dofs, &forces, &internal).max(self.force_floor);
+            let scale =
+                force_scale(&self.dofs, &self.applied(&forces), &internal).max(self.force_floor);
             let rnorm = norm(&r);
             if convergence
                 .record(Convergence::relative(rnorm, scale))

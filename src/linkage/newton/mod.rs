@@ -10,7 +10,8 @@
 //! converged states when that is closer to equilibrium, which saves the predictor's solve.
 
 use crate::linkage::body_state::{
-    fill_tangent, full_loads, internal_forces, loads_at, member_response_at, norm,
+    factor_at, fill_tangent, full_loads, internal_forces, loads_at, member_response_at,
+    node_vector, norm,
 };
 use crate::linkage::line_search::backtrack;
 use crate::linkage::mechanism::diagnose_mechanism;
@@ -94,7 +95,41 @@ pub struct NewtonEquilibrium {
     /// newest last, at most [`PATH_POINTS`]: the next increment starts from their
     /// extrapolation.
     path: Vec<(Real, Vec<Real>)>,
+    /// Force per body DOF of the following pressures at the current displacement, N.
+    follower: Vec<Real>,
+    /// The pseudo-time (step units) and steps the following pressures are evaluated at.
+    follower_time: (Real, usize),
+    /// Per node pair joined by a member, sorted: `((lower, higher), member)`, to place the
+    /// pressures' load stiffness (empty without pressures).
+    pair_members: Vec<((usize, usize), usize)>,
 }
+
+/// The force per body DOF (N) of `body`'s following pressures at displacement `u` (per body
+/// DOF, m), each at its schedule's factor at pseudo-time `t` of `steps`, on the deformed faces.
+pub(crate) fn follower_forces(body: &Body, u: &[Real], t: Real, steps: usize, out: &mut [Real]) {
+    out.iter_mut().for_each(|v| *v = 0.0);
+    let d = body.dimension.dofs_per_node();
+    for p in &body.pressures {
+        let factor = factor_at(&p.schedule, t, steps);
+        if factor == 0.0 {
+            continue;
+        }
+        crate::linkage::face_forces(
+            &p.faces,
+            p.pressure * factor,
+            |n| body.nodes[n] + node_vector(u, d, n),
+            |n, f| {
+                for k in 0..d {
+                    out[n * d + k] += f[k];
+                }
+            },
+        );
+    }
+}
+
+/// The skew part of the pressures' load stiffness on the free DOFs, relative to its symmetric
+/// part, below which the symmetric part is taken as the whole (round-off of a closed surface).
+const SYMMETRIC_LOAD_STIFFNESS: Real = 1e-8;
 
 /// Converged states kept for the extrapolation (three: up to a quadratic through them).
 const PATH_POINTS: usize = 3;
@@ -138,7 +173,22 @@ impl NewtonEquilibrium {
             force_floor: 0.0,
             displacement_floor: 0.0,
             path: vec![(0.0, vec![0.0; nd])],
+            follower: vec![0.0; nd],
+            follower_time: (0.0, 1),
+            pair_members: Vec::new(),
         };
+        if !body.pressures.is_empty() {
+            eq.pair_members = body
+                .members
+                .iter()
+                .enumerate()
+                .map(|(m, member)| {
+                    let [a, b] = member.nodes;
+                    ((a.min(b), a.max(b)), m)
+                })
+                .collect();
+            eq.pair_members.sort_unstable();
+        }
         eq.fill_tangent(body);
         eq.times.assembly += t.elapsed().as_secs_f64();
         if eq.assembly.n > 0 {
@@ -257,7 +307,12 @@ impl NewtonEquilibrium {
     /// The full state at the current displacement (post-processing shared with the linear
     /// solve).
     fn state(&self, body: &Body, steps: usize) -> StepState {
-        let forces = self.forces_at(body, self.step as Real, steps);
+        let mut forces = self.forces_at(body, self.step as Real, steps);
+        if !body.pressures.is_empty() {
+            let mut follower = vec![0.0; forces.len()];
+            follower_forces(body, &self.u, self.step as Real, steps, &mut follower);
+            forces.iter_mut().zip(&follower).for_each(|(f, p)| *f += p);
+        }
         let mut internal = vec![0.0; self.u.len()];
         internal_forces(body, &self.u, &mut internal);
         let members = (0..body.members.len()).map(|m| {
@@ -288,6 +343,69 @@ impl NewtonEquilibrium {
 
     fn fill_tangent(&mut self, body: &Body) {
         fill_tangent(body, &self.assembly, &self.u, &mut self.values);
+        if body.newton.load_stiffness {
+            self.add_load_stiffness(body);
+        }
+    }
+
+    /// Add the symmetric part of the following pressures' load stiffness at the current
+    /// displacement (see [`crate::linkage::symmetric_load_stiffness_blocks`]) where it is the
+    /// whole of it on the free DOFs (a closed surface under one pressure, or a rim that moves
+    /// only in supported directions): Newton is then exact and quadratic. Elsewhere the skew
+    /// part is not small, the symmetric part alone can slow Newton down, and the tangent
+    /// leaves the load stiffness out (Newton converges linearly).
+    fn add_load_stiffness(&mut self, body: &Body) {
+        let d = body.dimension.dofs_per_node();
+        let (t, steps) = self.follower_time;
+        let u = &self.u;
+        let slots = &self.dofs.slots;
+        let (skew, symmetric) = crate::linkage::load_stiffness_parts(
+            body.pressures
+                .iter()
+                .map(|p| (&p.faces, p.pressure * factor_at(&p.schedule, t, steps))),
+            |n| body.nodes[n] + node_vector(u, d, n),
+            |n, k| k < d && matches!(slots[n * d + k], crate::linkage::DofSlot::Free(_)),
+        );
+        if skew > SYMMETRIC_LOAD_STIFFNESS * symmetric {
+            return;
+        }
+        for p in &body.pressures {
+            let factor = factor_at(&p.schedule, t, steps);
+            if factor == 0.0 {
+                continue;
+            }
+            let (u, pairs, assembly, values) = (
+                &self.u,
+                &self.pair_members,
+                &self.assembly,
+                &mut self.values,
+            );
+            crate::linkage::symmetric_load_stiffness_blocks(
+                &p.faces,
+                p.pressure * factor,
+                |n| body.nodes[n] + node_vector(u, d, n),
+                |i, j, block| {
+                    // Each unordered pair comes as (i, j) and (j, i): keep the one with the
+                    // higher node as rows, which is what the lower triangle stores.
+                    if i <= j {
+                        return;
+                    }
+                    if let Ok(k) = pairs.binary_search_by(|probe| probe.0.cmp(&(j, i))) {
+                        assembly.add_pair_block(pairs[k].1, &block, values);
+                    }
+                },
+            );
+        }
+    }
+
+    /// The applied force per body DOF, N: the nodal `forces` plus the following pressures at
+    /// the current displacement (as last evaluated by [`Self::out_of_balance`]).
+    fn applied(&self, forces: &[Real]) -> Vec<Real> {
+        forces
+            .iter()
+            .zip(&self.follower)
+            .map(|(f, p)| f + p)
+            .collect()
     }
 
     fn factorize(&mut self) -> Result<usize, TangentError> {
@@ -335,16 +453,21 @@ impl NewtonEquilibrium {
         result.map_err(|e| self.describe(e))
     }
 
-    /// Internal forces and the free out-of-balance `F − f_int` at the current displacement
-    /// (timed as assembly).
+    /// Internal forces and the free out-of-balance `F + F_p − f_int` at the current
+    /// displacement, `F_p` the following pressures (kept for [`Self::applied`]; timed as
+    /// assembly).
     fn out_of_balance(&mut self, body: &Body, forces: &[Real], internal: &mut [Real]) -> Vec<Real> {
         let t = Instant::now();
         internal_forces(body, &self.u, internal);
+        if !body.pressures.is_empty() {
+            let (t1, steps) = self.follower_time;
+            follower_forces(body, &self.u, t1, steps, &mut self.follower);
+        }
         self.times.assembly += t.elapsed().as_secs_f64();
         self.dofs
             .free
             .iter()
-            .map(|&dof| forces[dof] - internal[dof])
+            .map(|&dof| forces[dof] + self.follower[dof] - internal[dof])
             .collect()
     }
 
