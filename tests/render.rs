@@ -32,6 +32,7 @@ fn square() -> (ModelFile, StepResult) {
                 node: 1,
                 fix: vec!["x".into(), "y".into()],
             }],
+            strengths: vec![[Some(8e6), Some(8e6)]; 4],
         }],
     };
     let stresses = vec![5e6, -5e6, 9e6, 0.0];
@@ -166,6 +167,7 @@ fn two_patches() -> (ModelFile, StepResult) {
             members: vec![[1, 2], [2, 3], [3, 1], [4, 5], [5, 6], [6, 4]],
             patches: vec![[1, 2, 3], [4, 5, 6]],
             supports: vec![],
+            strengths: vec![],
         }],
     };
     let step = StepResult {

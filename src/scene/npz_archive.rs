@@ -194,6 +194,11 @@ impl<'a> NpzIn<'a> {
         Ok(Array { shape, values })
     }
 
+    /// Whether the archive holds array `name`.
+    pub(crate) fn has(&mut self, name: &str) -> bool {
+        self.zip.by_name(&format!("{name}.npy")).is_ok()
+    }
+
     /// A `float64` array.
     pub(crate) fn f64s(&mut self, name: &str) -> Result<Array<f64>, String> {
         self.read(name)
