@@ -8,11 +8,11 @@ use rayon::prelude::*;
 const FRAME_DELAY: u16 = 50;
 const LAST_FRAME_DELAY: u16 = 200;
 
-/// Bits per channel of the colour look-up table (64³ cells).
-const LUT_BITS: u32 = 6;
+/// Bits per channel of the colour look-up table (32³ cells).
+const LUT_BITS: u32 = 5;
 
 /// At most this many pixels train the palette (spread evenly over the sample frames).
-const TRAINING_PIXELS: usize = 400_000;
+const TRAINING_PIXELS: usize = 100_000;
 
 fn encode_error(e: impl std::fmt::Display) -> RenderError {
     RenderError::Encode {
@@ -22,12 +22,13 @@ fn encode_error(e: impl std::fmt::Display) -> RenderError {
 }
 
 /// The 256 colours of an animation, computed once (NeuQuant over sample frames) instead of
-/// per frame, and a look-up table from colour to palette index, so that indexing a frame is
+/// per frame, and a look-up table from colour to palette index (NeuQuant's nearest colour of
+/// each cell's centre), so that indexing a frame is
 /// one table look-up per pixel.
 pub struct GifPalette {
     /// RGB bytes of the 256 colours.
     colours: Vec<u8>,
-    /// Palette index of each 6-bit-per-channel colour cell.
+    /// Palette index of each 5-bit-per-channel colour cell.
     lut: Vec<u8>,
     /// Palette indices of pure white and pure black (exact: background, text, overloaded
     /// members).
@@ -72,7 +73,7 @@ impl GifPalette {
                         as i32
                 };
                 let (r, g, b) = (channel(2), channel(1), channel(0));
-                nearest(&colours, r, g, b)
+                quant.index_of(&[r as u8, g as u8, b as u8, 255]) as u8
             })
             .collect();
         GifPalette {
@@ -121,18 +122,6 @@ impl GifPalette {
     pub fn colours(&self) -> &[u8] {
         &self.colours
     }
-}
-
-/// The palette index of the colour nearest (r, g, b).
-fn nearest(colours: &[u8], r: i32, g: i32, b: i32) -> u8 {
-    let mut best = (i32::MAX, 0u8);
-    for (k, c) in colours.chunks_exact(3).enumerate() {
-        let d = (c[0] as i32 - r).pow(2) + (c[1] as i32 - g).pow(2) + (c[2] as i32 - b).pow(2);
-        if d < best.0 {
-            best = (d, k as u8);
-        }
-    }
-    best.1
 }
 
 /// One frame indexed in the palette and LZW-compressed, ready to be appended.
