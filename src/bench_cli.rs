@@ -2,7 +2,7 @@
 //! table.
 
 use anyhow::{bail, Context, Result};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 pub(crate) fn bench_contact(
     cells: Vec<[usize; 3]>,
@@ -302,6 +302,29 @@ pub(crate) fn bench_render(patches: usize, size: [u32; 2]) -> Result<()> {
         format!("{}x{}", t.size[0], t.size[1]),
         t.draw,
         t.png
+    );
+    Ok(())
+}
+
+pub(crate) fn bench_gif(dir: &Path) -> Result<()> {
+    let t = linkage::bench::render::gif_benchmark(dir).map_err(anyhow::Error::msg)?;
+    println!(
+        "GIF of {} ({} frames of 1280x720, drawn in {:.3} s):",
+        dir.display(),
+        t.frames,
+        t.draw
+    );
+    println!(
+        "  a palette per frame (NeuQuant), sequential: {:.3} s, {} bytes",
+        t.per_frame_palette, t.bytes.0
+    );
+    println!(
+        "  one palette for the run, frames in parallel: {:.3} s, {} bytes",
+        t.shared_palette, t.bytes.1
+    );
+    println!(
+        "  speed-up: {:.1}x",
+        t.per_frame_palette / t.shared_palette.max(1e-12)
     );
     Ok(())
 }

@@ -5,8 +5,8 @@ mod bench_cli;
 
 use anyhow::{bail, Context, Result};
 use bench_cli::{
-    bench, bench_contact, bench_fracture, bench_large, bench_prepare, bench_read, bench_render,
-    bench_run,
+    bench, bench_contact, bench_fracture, bench_gif, bench_large, bench_prepare, bench_read,
+    bench_render, bench_run,
 };
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -46,6 +46,9 @@ enum Command {
         /// Also draw png/NNNN.png per stored step and anim.gif (as `[output] png = true`).
         #[arg(long)]
         png: bool,
+        /// Write no anim.gif (PNG frames only), whatever the scenes' `[output]` asks.
+        #[arg(long)]
+        no_gif: bool,
         /// Also write vtk/NNNN.vtu per stored step and vtk/<scene>.pvd for ParaView.
         #[arg(long)]
         vtk: bool,
@@ -176,6 +179,10 @@ enum Command {
         /// Time drawing one frame of a shaded shell instead (see --patches, --size).
         #[arg(long)]
         render: bool,
+        /// Time the GIF of a results folder's frames instead: a palette per frame (NeuQuant,
+        /// as before) against one palette for the run encoded in parallel, same frames.
+        #[arg(long, value_name = "DIR")]
+        gif: Option<PathBuf>,
         /// Time preparing a body of over 1,000,000 members from a torus mesh instead
         /// (isosurface stuffing): time and peak memory.
         #[arg(long)]
@@ -193,6 +200,10 @@ enum Command {
 struct RenderArgs {
     /// A results folder written by `linkage run` (DIR/<scene name>).
     dir: PathBuf,
+    /// Write png/, anim.gif (and vtk/) into this folder instead of the results folder
+    /// (created if missing; its png/ then holds the frames of this drawing only).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Frame width, pixels.
     #[arg(long, default_value_t = 1280)]
     width: u32,
@@ -214,7 +225,8 @@ struct RenderArgs {
     /// Displacement magnification (default: automatic, 1 unless displacements are tiny).
     #[arg(long)]
     magnification: Option<f64>,
-    /// "stress" (compression blue, tension red) or "plain".
+    /// "stress" (compression blue, tension red; 3D surfaces by the mean member stress at each
+    /// node), "max-stress" (3D surfaces by the largest member stress at each node) or "plain".
     #[arg(long, default_value = "stress")]
     colour: Colouring,
     /// Draw the members over 3D surfaces.
@@ -277,6 +289,7 @@ fn main() -> ExitCode {
             out,
             jobs,
             png,
+            no_gif,
             vtk,
             shard,
             rerun,
@@ -285,7 +298,12 @@ fn main() -> ExitCode {
             &out,
             jobs,
             shard.as_deref(),
-            JobSettings { png, vtk, rerun },
+            JobSettings {
+                png,
+                no_gif,
+                vtk,
+                rerun,
+            },
         ),
         Command::Collect { dir } => batch_cli::collect(&dir),
         Command::Slurm {
@@ -313,6 +331,7 @@ fn main() -> ExitCode {
             out,
         } => prepare(&input, spacing, &out),
         Command::Render(args) => render(&args),
+        Command::Bench { gif: Some(dir), .. } => bench_gif(&dir),
         Command::Bench {
             read: true, cells, ..
         } => bench_read(cells),
@@ -676,7 +695,7 @@ fn export(scene: &Path, out: &Path) -> Result<()> {
 }
 
 fn render(a: &RenderArgs) -> Result<()> {
-    use linkage::render::{render_run, RenderOptions};
+    use linkage::render::{render_run_to, RenderOptions};
     use linkage::scene::{write_vtk, RunResults, VtkEncoding};
     // A published results folder always has its summary: without it the folder is not one.
     let summary = a.dir.join("summary.json");
@@ -701,8 +720,12 @@ fn render(a: &RenderArgs) -> Result<()> {
         gif: !a.no_gif,
         supersampling: a.supersampling,
     };
+    let out = a.out.clone().unwrap_or_else(|| a.dir.clone());
+    if a.out.is_some() {
+        create_out_folder(&out)?;
+    }
     let t = Instant::now();
-    let report = render_run(&a.dir, &options)?;
+    let report = render_run_to(&a.dir, &out, &options)?;
     let seconds = t.elapsed().as_secs_f64();
     if options.png || options.gif {
         println!(
@@ -714,7 +737,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             report.magnification,
             report.frames.len(),
             if report.frames.len() == 1 { "" } else { "s" },
-            a.dir.join("png").display(),
+            out.join("png").display(),
             report
                 .gif
                 .as_ref()
@@ -729,11 +752,11 @@ fn render(a: &RenderArgs) -> Result<()> {
         } else {
             VtkEncoding::Binary
         };
-        let files = write_vtk(&run, &a.dir, encoding)?;
+        let files = write_vtk(&run, &out, encoding)?;
         println!(
             "wrote {} ParaView files in {}",
             files.len(),
-            a.dir.join("vtk").display()
+            out.join("vtk").display()
         );
     }
     Ok(())

@@ -33,6 +33,7 @@ fn square() -> (ModelFile, StepResult) {
                 fix: vec!["x".into(), "y".into()],
             }],
             member_materials: Vec::new(),
+            strengths: vec![[Some(8e6), Some(8e6)]; 4],
         }],
     };
     let stresses = vec![5e6, -5e6, 9e6, 0.0];
@@ -168,6 +169,7 @@ fn two_patches() -> (ModelFile, StepResult) {
             patches: vec![[1, 2, 3], [4, 5, 6]],
             supports: vec![],
             member_materials: Vec::new(),
+            strengths: vec![],
         }],
     };
     let step = StepResult {

@@ -43,6 +43,7 @@ pub fn bent_shell(rings: usize, sectors: usize) -> Result<(ModelFile, Vec<StepRe
                 })
                 .collect(),
             member_materials: Vec::new(),
+            strengths: Vec::new(),
         }],
     };
     let step = |k: usize, factor: Real| {
@@ -140,5 +141,77 @@ pub fn render_benchmark(
         size: [width, height],
         draw: best,
         png,
+    })
+}
+
+/// Seconds to build the GIF of the same frames two ways (see [`gif_benchmark`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GifTiming {
+    /// Frames in the animation.
+    pub frames: usize,
+    /// Drawing the frames (in parallel), s.
+    pub draw: Real,
+    /// A palette per frame by NeuQuant (speed 10), frames one after another: how the GIF was
+    /// made before the shared palette, s.
+    pub per_frame_palette: Real,
+    /// One palette for the run, frames indexed and compressed in parallel
+    /// ([`crate::render::GifAnimation`]), s.
+    pub shared_palette: Real,
+    /// Size of each GIF, bytes: (per-frame palettes, shared palette).
+    pub bytes: (usize, usize),
+}
+
+/// Draw every stored step of the results folder `dir` and time building its GIF with a
+/// palette per frame (NeuQuant per frame, sequential, as before) against the shared palette
+/// encoded in parallel, on the same frames in one process.
+pub fn gif_benchmark(dir: &std::path::Path) -> Result<GifTiming, String> {
+    use crate::render::{Frame, GifAnimation};
+    use rayon::prelude::*;
+    let run = crate::scene::RunResults::read(dir).map_err(|e| e.to_string())?;
+    let options = RenderOptions::default();
+    let extent = RunExtent::of_run(&run, None);
+    let t = Instant::now();
+    let frames: Vec<Frame> = run
+        .steps
+        .par_iter()
+        .map(|s| draw_frame(&run.model, s, &extent, &options).map_err(|e| e.to_string()))
+        .collect::<Result<_, _>>()?;
+    let draw = t.elapsed().as_secs_f64();
+    let (w, h) = (options.width as u16, options.height as u16);
+
+    let t = Instant::now();
+    let mut old = gif::Encoder::new(Vec::new(), w, h, &[]).map_err(|e| e.to_string())?;
+    for f in &frames {
+        let mut rgba = f.rgba();
+        let frame = gif::Frame::from_rgba_speed(w, h, &mut rgba, 10);
+        old.write_frame(&frame).map_err(|e| e.to_string())?;
+    }
+    let old = old.into_inner().map_err(|e| e.to_string())?;
+    let per_frame_palette = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let n = frames.len();
+    let samples: Vec<&Frame> = [0, n / 2, n.saturating_sub(1)]
+        .iter()
+        .filter_map(|&i| frames.get(i))
+        .collect();
+    let mut new =
+        GifAnimation::new(options.width, options.height, &samples).map_err(|e| e.to_string())?;
+    let encoded = frames
+        .par_iter()
+        .map(|f| new.encode(f))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    for (i, e) in encoded.into_iter().enumerate() {
+        new.push_encoded(e, i + 1 == n).map_err(|e| e.to_string())?;
+    }
+    let new = new.finish().map_err(|e| e.to_string())?;
+    let shared_palette = t.elapsed().as_secs_f64();
+    Ok(GifTiming {
+        frames: n,
+        draw,
+        per_frame_palette,
+        shared_palette,
+        bytes: (old.len(), new.len()),
     })
 }

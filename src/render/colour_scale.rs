@@ -34,7 +34,7 @@ impl Rgb {
     }
 }
 
-/// Overloaded members, supports: black, as in the paper.
+/// Overloaded members: black, as in the paper.
 pub const BLACK: Rgb = Rgb(0.0, 0.0, 0.0);
 /// Applied forces: blue, as in the paper.
 pub const FORCE_BLUE: Rgb = Rgb::bytes(16, 64, 220);
@@ -46,6 +46,14 @@ pub const STICK_GREEN: Rgb = Rgb::bytes(0, 150, 70);
 pub const SLIP_MAGENTA: Rgb = Rgb::bytes(200, 0, 140);
 /// The undeformed shape.
 pub const GHOST_GREY: Rgb = Rgb::bytes(150, 150, 150);
+/// Obstacles in 2D: fill (a warm stone grey, apart from every stress colour) and outline.
+pub const OBSTACLE_FILL: Rgb = Rgb::bytes(205, 196, 178);
+/// Outline of a 2D obstacle.
+pub const OBSTACLE_EDGE: Rgb = Rgb::bytes(120, 110, 92);
+/// Obstacles in 3D: the shaded surface's colour.
+pub const OBSTACLE_SURFACE: Rgb = Rgb::bytes(190, 180, 160);
+/// Support marks: a dark teal, apart from the black of overloaded members.
+pub const SUPPORT_TEAL: Rgb = Rgb::bytes(0, 112, 120);
 /// Text.
 pub const INK: Rgb = Rgb::bytes(30, 30, 34);
 /// Members and surfaces with `Colouring::Plain`.

@@ -16,8 +16,10 @@ pub struct DeformedBody<'a> {
     pub positions: Vec<Vector3<Real>>,
     /// Centre of the undeformed nodes, m (which side is "outside").
     pub centre: Vector3<Real>,
-    /// 1 where member j is overloaded.
+    /// Whether member j is overloaded.
     pub overloaded: Vec<bool>,
+    /// Whether member j is broken (fracture): it is left out of the drawing.
+    pub broken: Vec<bool>,
 }
 
 /// A 2- or 3-component list as a 3-vector (z = 0 in 2D).
@@ -45,6 +47,12 @@ impl<'a> DeformedBody<'a> {
                 *o = true;
             }
         }
+        let mut broken = vec![false; model.members.len()];
+        for &j in result.fracture.iter().flat_map(|f| &f.broken) {
+            if let Some(b) = broken.get_mut(j.wrapping_sub(1)) {
+                *b = true;
+            }
+        }
         DeformedBody {
             model,
             result,
@@ -52,6 +60,7 @@ impl<'a> DeformedBody<'a> {
             positions,
             centre,
             overloaded,
+            broken,
         }
     }
 

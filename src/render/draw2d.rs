@@ -27,7 +27,7 @@ pub fn line_widths(body: &DeformedBody, view: &View, ui: f32) -> (f32, f32, f32)
 
 /// The members of a body as lines: the undeformed shape as a faint ghost behind, members
 /// coloured by axial stress (or plain), overloaded members black and thicker on top, as in
-/// the paper's Fig. 6. Used for 2D bodies and for 3D bodies without patches (then drawn
+/// the paper's Fig. 6; broken members are left out, so a crack shows as a gap. Used for 2D bodies and for 3D bodies without patches (then drawn
 /// back to front).
 pub fn member_lines(
     body: &DeformedBody,
@@ -73,14 +73,19 @@ pub fn member_lines(
             depth_test: false,
         }
     };
-    for &j in order.iter().filter(|&&j| !body.overloaded[j]) {
+    let intact = |j: &&usize| !body.broken[**j];
+    for &j in order
+        .iter()
+        .filter(intact)
+        .filter(|&&j| !body.overloaded[j])
+    {
         let colour = match colouring {
-            Colouring::Stress => scale.colour(stress(j)),
+            Colouring::Stress | Colouring::MaxStress => scale.colour(stress(j)),
             Colouring::Plain => PLAIN,
         };
         out.push(line(j, colour, width));
     }
-    for &j in order.iter().filter(|&&j| body.overloaded[j]) {
+    for &j in order.iter().filter(intact).filter(|&&j| body.overloaded[j]) {
         out.push(line(j, BLACK, heavy));
     }
     out

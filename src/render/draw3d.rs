@@ -28,6 +28,23 @@ pub fn node_stresses(model: &ModelBody, stresses: &[Real]) -> Vec<Real> {
         .collect()
 }
 
+/// The stress of the most stressed member at each node (the signed value of largest
+/// magnitude), Pa (0 at a node without members): the value that colours a shaded surface with
+/// [`Colouring::MaxStress`], so a peak the mean would hide shows.
+pub fn node_peak_stresses(model: &ModelBody, stresses: &[Real]) -> Vec<Real> {
+    let mut peak: Vec<Real> = vec![0.0; model.nodes.len()];
+    for (m, &s) in model.members.iter().zip(stresses) {
+        for &k in m {
+            if let Some(p) = peak.get_mut(k.wrapping_sub(1)) {
+                if s.abs() > p.abs() {
+                    *p = s;
+                }
+            }
+        }
+    }
+    peak
+}
+
 /// Cosine of the crease angle: adjacent patches meeting at more than 45° keep their own
 /// normals there (the edges of a box stay sharp), flatter ones are shaded smoothly.
 const CREASE_COS: Real = std::f64::consts::FRAC_1_SQRT_2;
@@ -85,9 +102,11 @@ pub fn corner_normals(
         .collect()
 }
 
-/// A 3D body with patches: its surface shaded (coloured by the mean stress at the nodes or
-/// plain), the undeformed members as a faint ghost behind, optionally the members as a
-/// wireframe, and overloaded members as black lines on top (hidden where behind the surface).
+/// A 3D body with patches: its surface shaded (coloured by the mean or the largest member
+/// stress at the nodes, or plain), the undeformed members as a faint ghost behind, optionally
+/// the members as a wireframe, and overloaded members as black lines on top (hidden where
+/// behind the surface). Broken members are left out, and so are the patches they border,
+/// so a crack shows as a gap.
 pub fn shaded_surface(
     body: &DeformedBody,
     view: &View,
@@ -113,9 +132,29 @@ pub fn shaded_surface(
             });
         }
     }
-    let triangles: Vec<[usize; 3]> = model.patches.iter().map(|p| p.map(|k| k - 1)).collect();
+    let broken_edges: std::collections::HashSet<(usize, usize)> = members
+        .iter()
+        .zip(&body.broken)
+        .filter(|(_, b)| **b)
+        .map(|(m, _)| (m[0].min(m[1]) - 1, m[0].max(m[1]) - 1))
+        .collect();
+    let triangles: Vec<[usize; 3]> = model
+        .patches
+        .iter()
+        .map(|p| p.map(|k| k - 1))
+        .filter(|t| {
+            broken_edges.is_empty()
+                || ![(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]
+                    .iter()
+                    .any(|&(a, b)| broken_edges.contains(&(a.min(b), a.max(b))))
+        })
+        .collect();
     let colours: Vec<Rgb> = match colouring {
         Colouring::Stress => node_stresses(model, &body.result.stresses)
+            .iter()
+            .map(|&s| node_scale.colour(s))
+            .collect(),
+        Colouring::MaxStress => node_peak_stresses(model, &body.result.stresses)
             .iter()
             .map(|&s| node_scale.colour(s))
             .collect(),
@@ -139,12 +178,19 @@ pub fn shaded_surface(
             depth_test: true,
         }
     };
+    let intact = |j: &usize| !body.broken[*j];
     if wireframe {
-        for j in (0..members.len()).filter(|&j| !body.overloaded[j]) {
+        for j in (0..members.len())
+            .filter(intact)
+            .filter(|&j| !body.overloaded[j])
+        {
             out.push(line(j, Rgb(0.1, 0.1, 0.12), 0.45, width * 0.5));
         }
     }
-    for j in (0..members.len()).filter(|&j| body.overloaded[j]) {
+    for j in (0..members.len())
+        .filter(intact)
+        .filter(|&j| body.overloaded[j])
+    {
         out.push(line(j, BLACK, 1.0, heavy));
     }
     out

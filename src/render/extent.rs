@@ -1,7 +1,8 @@
 //! What stays fixed over the frames of a run: the box the camera fits, the magnification, the
 //! arrow scales and the colour ranges.
 
-use crate::render::draw3d::node_stresses;
+use crate::render::draw3d::{node_peak_stresses, node_stresses};
+use crate::render::obstacles::{bodies_diagonal, place_obstacle, HALF_SPACE_BAND};
 use crate::scene::{ModelFile, RunResults, StepResult};
 use crate::Real;
 use nalgebra::Vector3;
@@ -24,10 +25,15 @@ pub struct RunExtent {
     pub max: Vector3<Real>,
     /// Largest applied force at a node over the run, N.
     pub max_force: Real,
-    /// Arrow length per newton of applied force, m/N (the largest force gets 15% of `size`).
+    /// Largest contact force at a node over the run, N.
+    pub max_contact: Real,
+    /// Arrow length per newton of every force, applied or contact (one scale, so equal forces
+    /// draw equally long), m/N: the largest force gets 15% of `size`.
     pub force_scale: Real,
-    /// Arrow length per newton of contact force, m/N.
-    pub contact_scale: Real,
+    /// Whether bodies touch obstacles or each other in this run (there are obstacles, several
+    /// bodies or contact forces): the automatic magnification is then 1, so that nothing is
+    /// drawn through what it touches.
+    pub contact: bool,
     /// Whether some contact of the run has a tangential (friction) force: its arrows and
     /// legend are drawn.
     pub friction: bool,
@@ -35,6 +41,9 @@ pub struct RunExtent {
     pub stress_limit: Real,
     /// Largest |mean stress of the members at a node| over the run (surface colours), Pa.
     pub node_stress_limit: Real,
+    /// Largest |stress of the most stressed member at a node| over the run (surface colours
+    /// by the largest member stress), Pa.
+    pub node_peak_limit: Real,
     /// The last stored step.
     pub last_step: usize,
 }
@@ -136,6 +145,8 @@ impl RunExtent {
         let mut friction = false;
         let mut stress_limit: Real = 0.0;
         let mut node_stress_limit: Real = 0.0;
+        let mut node_peak_limit: Real = 0.0;
+        let mut touching = !model.obstacles.is_empty() || model.bodies.len() > 1;
         for r in steps {
             for (b, m) in r.bodies.iter().zip(&model.bodies) {
                 for u in &b.displacements {
@@ -144,6 +155,7 @@ impl RunExtent {
                 for l in &b.loads {
                     max_force = max_force.max(vec3(&l.force).norm());
                 }
+                touching |= !b.contacts.is_empty();
                 for c in &b.contacts {
                     max_contact = max_contact.max(vec3(&c.force).norm());
                     friction |= c.tangential_force.iter().any(|t| *t != 0.0);
@@ -155,18 +167,22 @@ impl RunExtent {
                     for s in node_stresses(m, &b.stresses) {
                         node_stress_limit = node_stress_limit.max(s.abs());
                     }
+                    for s in node_peak_stresses(m, &b.stresses) {
+                        node_peak_limit = node_peak_limit.max(s.abs());
+                    }
                 }
             }
         }
-        let magnification =
-            magnification.unwrap_or_else(|| auto_magnification(max_displacement, size));
-        let force_scale = if max_force > 0.0 {
-            0.15 * size / max_force
-        } else {
-            0.0
-        };
-        let contact_scale = if max_contact > 0.0 {
-            0.08 * size / max_contact
+        let magnification = magnification.unwrap_or_else(|| {
+            if touching {
+                1.0
+            } else {
+                auto_magnification(max_displacement, size)
+            }
+        });
+        let largest = max_force.max(max_contact);
+        let force_scale = if largest > 0.0 {
+            0.15 * size / largest
         } else {
             0.0
         };
@@ -188,11 +204,11 @@ impl RunExtent {
                     .loads
                     .iter()
                     .map(|l| (l.node, &l.force, force_scale))
-                    .chain(b.contacts.iter().map(|c| (c.node, &c.force, contact_scale)))
+                    .chain(b.contacts.iter().map(|c| (c.node, &c.force, force_scale)))
                     .chain(
                         b.contacts
                             .iter()
-                            .map(|c| (c.node, &c.tangential_force, contact_scale)),
+                            .map(|c| (c.node, &c.tangential_force, force_scale)),
                     );
                 for (node, f, scale) in forces {
                     let (t, h) = arrow_ends(at(node.saturating_sub(1)), vec3(f), scale, *centre);
@@ -203,6 +219,7 @@ impl RunExtent {
                 }
             }
         }
+        include_obstacles(model, steps, &mut lo, &mut hi);
         // Room for support marks around the shape.
         let pad = Vector3::repeat(0.02 * size);
         RunExtent {
@@ -213,14 +230,76 @@ impl RunExtent {
             min: lo - pad,
             max: hi + pad,
             max_force,
+            max_contact,
             force_scale,
-            contact_scale,
+            contact: touching,
             friction,
             stress_limit,
             node_stress_limit,
+            node_peak_limit,
             last_step,
         }
     }
+}
+
+/// How far around the bodies (and their arrows) the camera takes in obstacles, in bounding
+/// diagonals of the bodies: a block under a shell shows whole, a floor only near the bodies.
+pub const OBSTACLE_MARGIN: Real = 0.25;
+
+/// Grow the box `lo`–`hi` (the bodies and their arrows) by the parts of the obstacles of
+/// `model`, at each of `steps`, that lie within [`OBSTACLE_MARGIN`] of it (2D: their cut by
+/// z = 0 as drawn).
+fn include_obstacles(
+    model: &ModelFile,
+    steps: &[StepResult],
+    lo: &mut Vector3<Real>,
+    hi: &mut Vector3<Real>,
+) {
+    if model.obstacles.is_empty() {
+        return;
+    }
+    let is_3d = model.bodies.iter().any(|b| b.dimension == 3);
+    let diagonal = bodies_diagonal(model);
+    let unit = if diagonal > 0.0 { diagonal } else { 1.0 };
+    let margin = Vector3::repeat(OBSTACLE_MARGIN * unit);
+    let (near_lo, near_hi) = (*lo - margin, *hi + margin);
+    let mut grow_lo = *lo;
+    let mut grow_hi = *hi;
+    let stored: Vec<usize> = if steps.is_empty() {
+        vec![0]
+    } else {
+        steps.iter().map(|s| s.step).collect()
+    };
+    for o in &model.obstacles {
+        for &k in &stored {
+            let placed = place_obstacle(o, k, diagonal);
+            let points: Vec<Vector3<Real>> = if is_3d {
+                placed.vertices.clone()
+            } else {
+                placed
+                    .cut(HALF_SPACE_BAND * unit)
+                    .into_iter()
+                    .flatten()
+                    .collect()
+            };
+            let (mut a, mut b) = (
+                Vector3::repeat(Real::INFINITY),
+                Vector3::repeat(Real::NEG_INFINITY),
+            );
+            for p in &points {
+                a = a.inf(p);
+                b = b.sup(p);
+            }
+            // The obstacle's box clipped to the near box; nothing when they do not meet.
+            let (a, b) = (a.sup(&near_lo), b.inf(&near_hi));
+            if (0..3).all(|i| a[i] <= b[i]) {
+                grow_lo = grow_lo.inf(&a);
+                grow_hi = grow_hi.sup(&b);
+            }
+        }
+    }
+    *lo = grow_lo;
+    *hi = grow_hi;
 }
 
 #[cfg(test)]

@@ -6,8 +6,9 @@ use crate::render::extent::arrow_ends;
 use crate::render::{Primitive, RunExtent};
 use nalgebra::Vector3;
 
-/// Supports (a black mark across each held direction, on the outside of the body), applied
-/// forces (blue arrows, one length scale for the whole run), contact forces (orange arrows)
+/// Supports (a teal mark across each held direction, on the outside of the body), applied
+/// forces (blue arrows) and contact forces (orange arrows) on one length scale for the whole
+/// run
 /// and their tangential (friction) part (green where the contact sticks, magenta where it
 /// slips) of one body. `depth_test`: hide those behind surfaces (3D).
 pub fn markers(body: &DeformedBody, extent: &RunExtent, depth_test: bool) -> Vec<Primitive> {
@@ -57,7 +58,7 @@ pub fn markers(body: &DeformedBody, extent: &RunExtent, depth_test: bool) -> Vec
             body.result
                 .contacts
                 .iter()
-                .map(|c| (c.node, &c.force, extent.contact_scale, CONTACT_ORANGE, 2.0)),
+                .map(|c| (c.node, &c.force, extent.force_scale, CONTACT_ORANGE, 2.0)),
         )
         .chain(body.result.contacts.iter().map(|c| {
             let colour = if c.state == "stick" {
@@ -65,13 +66,7 @@ pub fn markers(body: &DeformedBody, extent: &RunExtent, depth_test: bool) -> Vec
             } else {
                 SLIP_MAGENTA
             };
-            (
-                c.node,
-                &c.tangential_force,
-                extent.contact_scale,
-                colour,
-                2.0,
-            )
+            (c.node, &c.tangential_force, extent.force_scale, colour, 2.0)
         }));
     for (node, f, scale, colour, width) in forces {
         if f.iter().all(|x| *x == 0.0) {

@@ -1,16 +1,21 @@
 //! Pictures of stored results: PNG frames and a GIF of a run, 2D line art and shaded 3D patches.
 
 pub use self::camera::{Camera, View, FIELD_OF_VIEW};
-pub use self::colour_scale::{colour_at, format_si, ColourScale, Rgb};
+pub use self::colour_scale::{
+    colour_at, format_si, ColourScale, Rgb, CONTACT_ORANGE, FORCE_BLUE, OBSTACLE_FILL,
+    OBSTACLE_SURFACE, SUPPORT_TEAL,
+};
 pub use self::error::RenderError;
 pub use self::extent::{auto_magnification, RunExtent};
 pub use self::frame::Frame;
-pub use self::gif::GifAnimation;
+pub use self::gif::{EncodedFrame, GifAnimation, GifPalette};
 pub use self::options::{Colouring, Projection, RenderOptions, StepSelection};
-pub use self::picture::{camera_for, draw_frame, view_for, viewport_for};
+pub use self::picture::{camera_for, draw_frame, frame_primitives, view_for, viewport_for};
 pub use self::primitives::{paint, Layer, Mesh, Primitive};
 pub use self::raster::{Lighting, RasterVertex, Rasteriser};
-pub use self::run_pictures::{draw_run, render_run, select_steps, PictureWriter, RenderReport};
+pub use self::run_pictures::{
+    draw_run, render_run, render_run_to, select_steps, PictureWriter, RenderReport,
+};
 
 mod camera;
 mod colour_scale;
@@ -22,6 +27,7 @@ mod extent;
 mod frame;
 mod gif;
 mod markers;
+mod obstacles;
 mod options;
 mod overlay;
 mod picture;

@@ -30,8 +30,12 @@ impl FromStr for Projection {
 /// What sets the colour of members and surfaces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Colouring {
-    /// Axial stress on a diverging scale: compression blue, tension red (with a colour bar).
+    /// Axial stress on a diverging scale: compression blue, tension red (with a colour bar);
+    /// a 3D surface by the mean stress of the members at each node.
     Stress,
+    /// As `Stress`, but a 3D surface by the stress of the most stressed member at each node
+    /// (the value of largest magnitude), so peaks show; 2D members as `Stress`.
+    MaxStress,
     /// One neutral colour: shape and shading only (overloaded members stay black).
     Plain,
 }
@@ -41,8 +45,11 @@ impl FromStr for Colouring {
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
             "stress" => Ok(Colouring::Stress),
+            "max-stress" | "max_stress" => Ok(Colouring::MaxStress),
             "plain" | "none" => Ok(Colouring::Plain),
-            _ => Err(format!("colouring {s:?}: give \"stress\" or \"plain\"")),
+            _ => Err(format!(
+                "colouring {s:?}: give \"stress\", \"max-stress\" or \"plain\""
+            )),
         }
     }
 }
@@ -152,6 +159,11 @@ impl RenderOptions {
             azimuth: s.azimuth,
             elevation: s.elevation,
             magnification: s.magnification,
+            colouring: s
+                .colour
+                .as_deref()
+                .and_then(|c| c.parse().ok())
+                .unwrap_or(Colouring::Stress),
             png: s.png,
             gif: s.gif,
             ..RenderOptions::default()

@@ -1,7 +1,8 @@
 //! The furniture of a frame: its layout, the colour bar and the labels.
 
 use crate::render::colour_scale::{
-    colour_at, format_si, si_unit, BLACK, FORCE_BLUE, INK, SLIP_MAGENTA, STICK_GREEN,
+    colour_at, format_si, si_unit, BLACK, CONTACT_ORANGE, FORCE_BLUE, INK, OBSTACLE_FILL,
+    SLIP_MAGENTA, STICK_GREEN, SUPPORT_TEAL,
 };
 use crate::render::text::{draw_text, text_width};
 use crate::render::{Frame, Rgb};
@@ -60,14 +61,37 @@ pub struct Caption {
     pub max_displacement: Real,
     /// Overloaded members at this step.
     pub overloaded: usize,
+    /// Broken members so far (`None`: nothing in the run can break).
+    pub broken: Option<usize>,
+    /// The member stress of largest magnitude at this step, Pa, and its ratio to that
+    /// member's strength when it has one.
+    pub peak_stress: Option<(Real, Option<Real>)>,
     /// Displacement magnification.
     pub magnification: Real,
     /// Colour bar: (title, limit in Pa) when colouring by stress.
     pub stress_bar: Option<(String, Real)>,
     /// Largest applied force over the run, N (0: no force legend).
     pub max_force: Real,
+    /// Largest contact force over the run, N (0: no contact legend).
+    pub max_contact: Real,
     /// Whether the run has friction forces (their legend: sticking and slipping).
     pub friction: bool,
+    /// Whether some body has supports (their legend).
+    pub supports: bool,
+    /// Whether the run has obstacles (their legend).
+    pub obstacles: bool,
+}
+
+/// How a legend entry's sample is drawn.
+enum Swatch {
+    /// A thick line in a colour.
+    Line(Rgb),
+    /// A support mark.
+    Support,
+    /// A filled square in a colour.
+    Block(Rgb),
+    /// An arrow in a colour.
+    Arrow(Rgb),
 }
 
 fn fmt_number(v: Real) -> String {
@@ -103,6 +127,20 @@ pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
         c.overloaded,
         if c.overloaded == 1 { "" } else { "s" }
     ));
+    if let Some(n) = c.broken {
+        sub.push_str(&format!("  ·  {n} broken"));
+    }
+    if let Some((peak, ratio)) = c.peak_stress {
+        let signed = if peak > 0.0 {
+            format!("+{}", format_si(peak, "Pa"))
+        } else {
+            format_si(peak, "Pa").replace('-', "−")
+        };
+        sub.push_str(&format!("  ·  peak member stress {signed}"));
+        if let Some(r) = ratio {
+            sub.push_str(&format!(" ({:.0}% of its strength)", 100.0 * r));
+        }
+    }
     draw_text(
         &mut frame.pixmap,
         &sub,
@@ -125,11 +163,16 @@ pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
         let x0 = w - 200.0 * ui;
         let bw = 22.0 * ui;
         let top = 130.0 * ui;
-        let bottom = (h - 220.0 * ui).max(top + 60.0 * ui);
+        let bottom = (h - 330.0 * ui).max(top + 60.0 * ui);
         let (div, unit) = si_unit(*limit, "Pa");
+        // "mean member stress at nodes": the quantity, then where and the unit below it.
+        let (what, place) = match bar_title.split_once(" at ") {
+            Some((what, place)) => (what.to_string(), format!("at {place} ({unit})")),
+            None => (bar_title.clone(), format!("({unit})")),
+        };
         draw_text(
             &mut frame.pixmap,
-            bar_title,
+            &what,
             x0 - 10.0 * ui,
             top - 34.0 * ui,
             small,
@@ -137,7 +180,7 @@ pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
         );
         draw_text(
             &mut frame.pixmap,
-            &format!("({unit})"),
+            &place,
             x0 - 10.0 * ui,
             top - 14.0 * ui,
             small * 0.9,
@@ -211,69 +254,116 @@ pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
         );
 
         // Legend.
-        let ly = bottom + 62.0 * ui;
-        let mut black = Paint::default();
-        black.set_color(BLACK.with_alpha(1.0));
-        black.anti_alias = true;
-        let mut pb = PathBuilder::new();
-        pb.move_to(x0, ly);
-        pb.line_to(x0 + 34.0 * ui, ly);
-        if let Some(path) = pb.finish() {
-            let s = Stroke {
-                width: 5.0 * ui,
-                line_cap: LineCap::Round,
-                ..Stroke::default()
-            };
-            frame
-                .pixmap
-                .stroke_path(&path, &black, &s, Transform::identity(), None);
+        let mut entries: Vec<(Swatch, String, Option<String>)> =
+            vec![(Swatch::Line(BLACK), "overloaded".to_string(), None)];
+        if c.supports {
+            entries.push((Swatch::Support, "support".to_string(), None));
         }
-        draw_text(
-            &mut frame.pixmap,
-            "overloaded",
-            x0 + 44.0 * ui,
-            ly + 6.0 * ui,
-            small,
-            INK,
-        );
-        let mut next = ly + 34.0 * ui;
+        if c.obstacles {
+            entries.push((Swatch::Block(OBSTACLE_FILL), "obstacle".to_string(), None));
+        }
         if c.max_force > 0.0 {
-            legend_arrow(frame, x0, ly + 34.0 * ui, ui, FORCE_BLUE);
-            next += 56.0 * ui;
-            draw_text(
-                &mut frame.pixmap,
-                "applied force",
-                x0 + 44.0 * ui,
-                ly + 40.0 * ui,
-                small,
-                INK,
-            );
-            draw_text(
-                &mut frame.pixmap,
-                &format!("(largest {})", format_si(c.max_force, "N")),
-                x0 + 44.0 * ui,
-                ly + 62.0 * ui,
-                small * 0.85,
-                Rgb(0.35, 0.35, 0.38),
-            );
+            entries.push((
+                Swatch::Arrow(FORCE_BLUE),
+                "applied force".to_string(),
+                Some(format!("(largest {})", format_si(c.max_force, "N"))),
+            ));
+        }
+        if c.max_contact > 0.0 {
+            entries.push((
+                Swatch::Arrow(CONTACT_ORANGE),
+                "contact force".to_string(),
+                Some(format!("(largest {})", format_si(c.max_contact, "N"))),
+            ));
         }
         if c.friction {
             for (label, colour) in [
                 ("friction, sticking", STICK_GREEN),
                 ("friction, slipping", SLIP_MAGENTA),
             ] {
-                legend_arrow(frame, x0, next, ui, colour);
-                draw_text(
-                    &mut frame.pixmap,
-                    label,
-                    x0 + 44.0 * ui,
-                    next + 6.0 * ui,
-                    small,
-                    INK,
-                );
-                next += 28.0 * ui;
+                entries.push((Swatch::Arrow(colour), label.to_string(), None));
             }
         }
+        let mut y = bottom + 58.0 * ui;
+        let grey = Rgb(0.35, 0.35, 0.38);
+        for (swatch, label, sub) in entries {
+            draw_swatch(frame, &swatch, x0, y, ui);
+            draw_text(
+                &mut frame.pixmap,
+                &label,
+                x0 + 44.0 * ui,
+                y + 6.0 * ui,
+                small,
+                INK,
+            );
+            y += 26.0 * ui;
+            if let Some(sub) = sub {
+                draw_text(
+                    &mut frame.pixmap,
+                    &sub,
+                    x0 + 44.0 * ui,
+                    y + 2.0 * ui,
+                    small * 0.8,
+                    grey,
+                );
+                y += 22.0 * ui;
+            }
+        }
+    }
+}
+
+/// The sample of a legend entry at (`x`, `y`), 34 × `ui` pixels wide.
+fn draw_swatch(frame: &mut Frame, swatch: &Swatch, x: f32, y: f32, ui: f32) {
+    let paint_of = |colour: Rgb| {
+        let mut paint = Paint::default();
+        paint.set_color(colour.with_alpha(1.0));
+        paint.anti_alias = true;
+        paint
+    };
+    let line = |frame: &mut Frame, colour: Rgb, a: (f32, f32), b: (f32, f32), width: f32| {
+        let mut pb = PathBuilder::new();
+        pb.move_to(a.0, a.1);
+        pb.line_to(b.0, b.1);
+        if let Some(path) = pb.finish() {
+            let s = Stroke {
+                width,
+                line_cap: LineCap::Round,
+                ..Stroke::default()
+            };
+            frame
+                .pixmap
+                .stroke_path(&path, &paint_of(colour), &s, Transform::identity(), None);
+        }
+    };
+    match swatch {
+        Swatch::Line(colour) => line(frame, *colour, (x, y), (x + 34.0 * ui, y), 5.0 * ui),
+        Swatch::Support => {
+            line(
+                frame,
+                SUPPORT_TEAL,
+                (x + 4.0 * ui, y - 4.0 * ui),
+                (x + 30.0 * ui, y - 4.0 * ui),
+                3.2 * ui,
+            );
+            for k in 0..4 {
+                let sx = x + (7.0 + 6.5 * k as f32) * ui;
+                line(
+                    frame,
+                    SUPPORT_TEAL,
+                    (sx, y - 4.0 * ui),
+                    (sx - 5.0 * ui, y + 5.0 * ui),
+                    1.4 * ui,
+                );
+            }
+        }
+        Swatch::Block(colour) => {
+            if let Some(rect) = Rect::from_xywh(x, y - 8.0 * ui, 34.0 * ui, 16.0 * ui) {
+                frame
+                    .pixmap
+                    .fill_rect(rect, &paint_of(*colour), Transform::identity(), None);
+            }
+        }
+        Swatch::Arrow(colour) => legend_arrow(frame, x, y, ui, *colour),
     }
 }
 

@@ -82,12 +82,22 @@ pub enum Primitive {
     },
     /// A shaded surface.
     Surface(Mesh),
+    /// A filled region (a 2D obstacle): closed loops of points filled by the even-odd rule
+    /// (holes stay empty) and outlined; painted first, under everything else.
+    Region {
+        /// Loops of points, m (the last point may repeat the first).
+        loops: Vec<Vec<Vector3<Real>>>,
+        /// Fill colour.
+        fill: Rgb,
+        /// Outline colour.
+        edge: Rgb,
+    },
 }
 
 /// Size of marks and arrow heads, pixels at 720 pixels of frame height.
 const SUPPORT_SIZE: f32 = 24.0;
 
-/// Paint `primitives` onto `frame` through `view`: first the `Behind` lines, then all
+/// Paint `primitives` onto `frame` through `view`: first the regions, then the `Behind` lines, then all
 /// surfaces together through one depth buffer (`supersampling`² samples per pixel), then the
 /// rest in list order, depth-tested against the surfaces where asked.
 pub fn paint(
@@ -99,6 +109,11 @@ pub fn paint(
 ) {
     let ui = crate::render::overlay::ui_scale(frame.width(), frame.height());
     let ss = supersampling.max(1) as usize;
+    for p in primitives {
+        if let Primitive::Region { loops, fill, edge } = p {
+            draw_region(frame, view, loops, *fill, *edge, ui);
+        }
+    }
     for p in primitives {
         if let Primitive::Line {
             layer: Layer::Behind,
@@ -197,7 +212,7 @@ pub fn paint(
                 let h = 3.5 * ui;
                 if let Some(rect) = tiny_skia::Rect::from_xywh(p[0] - h, p[1] - h, 2.0 * h, 2.0 * h)
                 {
-                    let paint = paint_of(crate::render::colour_scale::BLACK, 1.0);
+                    let paint = paint_of(crate::render::colour_scale::SUPPORT_TEAL, 1.0);
                     frame
                         .pixmap
                         .fill_rect(rect, &paint, Transform::identity(), None);
@@ -409,7 +424,7 @@ fn draw_arrow(frame: &mut Frame, tail: [f32; 3], tip: [f32; 3], colour: Rgb, wid
 /// A support mark at `p` for the held direction pointing from `p` to `q` (projected).
 fn draw_support(frame: &mut Frame, p: [f32; 3], q: [f32; 3], ui: f32) {
     let size = SUPPORT_SIZE * ui;
-    let paint = paint_of(crate::render::colour_scale::BLACK, 1.0);
+    let paint = paint_of(crate::render::colour_scale::SUPPORT_TEAL, 1.0);
     let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
     let len = (dx * dx + dy * dy).sqrt();
     if len < 0.2 * 10.0 || !len.is_finite() {
@@ -446,4 +461,42 @@ fn draw_support(frame: &mut Frame, p: [f32; 3], q: [f32; 3], ui: f32) {
     }
     stroke_segments(frame, &segments[..1], &paint, 3.2 * ui);
     stroke_segments(frame, &segments[1..], &paint, 1.4 * ui);
+}
+
+/// A filled region: `loops` (world points) filled even-odd in `fill`, outlined in `edge`.
+fn draw_region(
+    frame: &mut Frame,
+    view: &View,
+    loops: &[Vec<Vector3<Real>>],
+    fill: Rgb,
+    edge: Rgb,
+    ui: f32,
+) {
+    let mut pb = PathBuilder::new();
+    for l in loops {
+        for (i, p) in l.iter().enumerate() {
+            let q = view.project(p);
+            if i == 0 {
+                pb.move_to(q[0], q[1]);
+            } else {
+                pb.line_to(q[0], q[1]);
+            }
+        }
+        pb.close();
+    }
+    let Some(path) = pb.finish() else { return };
+    frame.pixmap.fill_path(
+        &path,
+        &paint_of(fill, 1.0),
+        FillRule::EvenOdd,
+        Transform::identity(),
+        None,
+    );
+    frame.pixmap.stroke_path(
+        &path,
+        &paint_of(edge, 1.0),
+        &stroke(1.5 * ui),
+        Transform::identity(),
+        None,
+    );
 }

@@ -2,12 +2,13 @@
 //! results in memory (during `linkage run`) or read back from a results folder (`linkage render`).
 
 use crate::render::{
-    draw_frame, GifAnimation, RenderError, RenderOptions, RunExtent, StepSelection,
+    draw_frame, Frame, GifAnimation, RenderError, RenderOptions, RunExtent, StepSelection,
 };
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::publish::{publish_keeping, remove_stale, staging_dir};
 use crate::scene::MIN_STEP_DIGITS;
 use crate::scene::{DrawResults, RunResults, StoredRun, World};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// What [`render_run`] wrote.
@@ -73,15 +74,32 @@ fn stored_list(steps: &[usize]) -> String {
 /// `anim.gif` of them, as `options` ask; each file is written atomically. The camera, the
 /// magnification, the force scale and the colour range are fixed over all stored steps.
 pub fn render_run(dir: &Path, options: &RenderOptions) -> Result<RenderReport, RenderError> {
+    render_run_to(dir, dir, options)
+}
+
+/// Draw the stored run in `dir` as [`render_run`] does, writing `out/png/NNNN.png` and
+/// `out/anim.gif` instead (`out` is created if missing; its `png/` then holds this drawing's
+/// frames only).
+pub fn render_run_to(
+    dir: &Path,
+    out: &Path,
+    options: &RenderOptions,
+) -> Result<RenderReport, RenderError> {
     options.check()?;
     let stored = StoredRun::open(dir)?;
     // The selection is checked before the steps are read.
     select_steps(&stored, &options.steps)?;
     let run = stored.read_all()?;
-    draw_run(&run, dir, options)
+    if out != dir {
+        std::fs::create_dir_all(out).map_err(|source| RenderError::Write {
+            path: out.to_path_buf(),
+            source,
+        })?;
+    }
+    draw_run(&run, out, options)
 }
 
-/// Draw `run` into its results folder `dir` as [`render_run`] does: `png/NNNN.png` per step
+/// Draw `run` into the folder `dir` as [`render_run`] does: `png/NNNN.png` per step
 /// `options.steps` selects and `anim.gif` of them, as `options` ask.
 pub fn draw_run(
     run: &RunResults,
@@ -125,8 +143,24 @@ fn is_frame(name: &std::ffi::OsStr) -> bool {
         })
 }
 
+/// The first, middle and last of `steps` (without repeats): the frames the GIF's palette is
+/// computed from (the colours grow with the load).
+fn palette_steps(steps: &[usize]) -> Vec<usize> {
+    let mut picked = Vec::new();
+    for i in [0, steps.len() / 2, steps.len().saturating_sub(1)] {
+        if let Some(&k) = steps.get(i) {
+            if !picked.contains(&k) {
+                picked.push(k);
+            }
+        }
+    }
+    picked
+}
+
 /// The drawing of [`draw_run`]: frames into the staging folder `png_dir`, published as
-/// `dir/png` when all are drawn, and the GIF.
+/// `dir/png` when all are drawn, and the GIF. Frames are drawn, encoded and written in
+/// parallel, a batch at a time (memory stays bounded); the GIF is appended in step order, so
+/// the files do not depend on the number of threads.
 fn draw_frames(
     run: &RunResults,
     dir: &Path,
@@ -137,29 +171,59 @@ fn draw_frames(
     mut report: RenderReport,
 ) -> Result<RenderReport, RenderError> {
     let final_png = dir.join("png");
-    let mut gif = if options.gif {
-        Some(GifAnimation::new(options.width, options.height)?)
-    } else {
-        None
-    };
-    for (i, &k) in steps.iter().enumerate() {
+    let draw = |k: usize| -> Result<Frame, RenderError> {
         let result = run.step(k).ok_or_else(|| RenderError::NoSuchStep {
             step: k,
             dir: dir.to_path_buf(),
             stored: stored_list(&run.step_numbers()),
         })?;
-        let frame = draw_frame(&run.model, result, extent, options)?;
-        if options.png {
-            let name = format!("{}.png", run.stem(k));
-            let path = png_dir.join(&name);
-            write_atomically(&path, &frame.png()?).map_err(|source| RenderError::Write {
-                path: path.clone(),
-                source,
-            })?;
-            report.frames.push(final_png.join(name));
-        }
-        if let Some(g) = gif.as_mut() {
-            g.push(&frame, i + 1 == steps.len())?;
+        draw_frame(&run.model, result, extent, options)
+    };
+    // The palette's frames are drawn first and kept for their own turn.
+    let mut kept: Vec<(usize, Frame)> = Vec::new();
+    let gif = if options.gif {
+        kept = palette_steps(steps)
+            .into_par_iter()
+            .map(|k| draw(k).map(|f| (k, f)))
+            .collect::<Result<_, _>>()?;
+        let samples: Vec<&Frame> = kept.iter().map(|(_, f)| f).collect();
+        Some(GifAnimation::new(options.width, options.height, &samples)?)
+    } else {
+        None
+    };
+    let batch = (2 * rayon::current_num_threads()).max(4);
+    let mut gif = gif;
+    for (b, chunk) in steps.chunks(batch).enumerate() {
+        let done = chunk
+            .par_iter()
+            .map(|&k| {
+                let owned;
+                let frame = match kept.iter().find(|(s, _)| *s == k) {
+                    Some((_, f)) => f,
+                    None => {
+                        owned = draw(k)?;
+                        &owned
+                    }
+                };
+                let mut name = None;
+                if options.png {
+                    let file = format!("{}.png", run.stem(k));
+                    let path = png_dir.join(&file);
+                    write_atomically(&path, &frame.png()?)
+                        .map_err(|source| RenderError::Write { path, source })?;
+                    name = Some(file);
+                }
+                let encoded = gif.as_ref().map(|g| g.encode(frame)).transpose()?;
+                Ok((name, encoded))
+            })
+            .collect::<Result<Vec<_>, RenderError>>()?;
+        for (i, (name, encoded)) in done.into_iter().enumerate() {
+            if let Some(name) = name {
+                report.frames.push(final_png.join(name));
+            }
+            if let (Some(g), Some(e)) = (gif.as_mut(), encoded) {
+                g.push_encoded(e, b * batch + i + 1 == steps.len())?;
+            }
         }
     }
     if options.png {

@@ -38,6 +38,12 @@ pub struct ModelBody {
     /// files of older runs).
     #[serde(default)]
     pub member_materials: Vec<String>,
+    /// Each member's strength, Pa, `[tension, compression]` (`null` where its material has
+    /// none; a breaking member's own strength when it is scattered); empty, and absent from
+    /// the file, when no material of the body has a strength. Pictures give the peak stress's
+    /// ratio to it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub strengths: Vec<[Option<Real>; 2]>,
 }
 
 /// One rigid obstacle of `model.json`: its surface at step 0 and its translation per step.
@@ -115,6 +121,32 @@ fn model_obstacles(world: &World) -> Vec<ModelObstacle> {
         .collect()
 }
 
+/// Each member's `[tension, compression]` strength of `body` (Pa; `None` where its material
+/// has none): the drawn strength of a breaking member with scatter, else its material's. Empty
+/// when no material has a strength.
+fn member_strengths(body: &crate::linkage::Body) -> Vec<[Option<Real>; 2]> {
+    if !body
+        .materials
+        .iter()
+        .any(|m| m.tensile_strength.is_some() || m.compressive_strength.is_some())
+    {
+        return Vec::new();
+    }
+    let finite = |s: Real| s.is_finite().then_some(s);
+    let limits = crate::linkage::fracture::member_limits(body);
+    body.members
+        .iter()
+        .zip(&limits)
+        .map(|(m, limit)| match limit {
+            Some((t, c)) => [finite(*t), finite(*c)],
+            None => {
+                let mat = &body.materials[m.material];
+                [mat.tensile_strength, mat.compressive_strength]
+            }
+        })
+        .collect()
+}
+
 /// The patches of `body`, a closed surface turned outward as contact sees it
 /// ([`PatchSurface::of`]); an open shell or a surface that is not consistent as given.
 fn outward_patches(body: &crate::linkage::Body) -> Vec<[usize; 3]> {
@@ -173,6 +205,7 @@ impl ModelFile {
                         .iter()
                         .map(|m| b.materials[m.material].name.clone())
                         .collect(),
+                    strengths: member_strengths(b),
                 }
             })
             .collect();
@@ -237,6 +270,14 @@ impl ModelFile {
                     "body '{}': {} member materials for {} members",
                     b.name,
                     b.member_materials.len(),
+                    b.members.len()
+                ));
+            }
+            if !b.strengths.is_empty() && b.strengths.len() != b.members.len() {
+                return Some(format!(
+                    "body '{}': {} strengths for {} members",
+                    b.name,
+                    b.strengths.len(),
                     b.members.len()
                 ));
             }

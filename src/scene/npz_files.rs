@@ -264,8 +264,9 @@ pub(crate) fn read_step_npz(bytes: &[u8], model: &ModelFile) -> Result<StepResul
 
 /// The bytes of `model.npz` of `model`: `scene`, `bodies` (names), per body `body<k>_dimension`,
 /// `_nodes` (n × d), `_members` (m × 2, 1-based), `_patches` (p × 3, 1-based), `_supports_node`
-/// (1-based), `_supports_fix` (bool, s × d: x, y(, z) held) and `_member_materials` (m, the
-/// name of each member's material); `obstacles` (names) and per
+/// (1-based), `_supports_fix` (bool, s × d: x, y(, z) held), `_member_materials` (m, the
+/// name of each member's material) and, when a material has a strength, `_strengths` (m × 2,
+/// Pa: tension, compression; NaN for none); `obstacles` (names) and per
 /// obstacle `obstacle<k>_vertices` (v × 3), `_triangles` (t × 3, 1-based), `_offsets`
 /// ((steps + 1) × 3).
 pub(crate) fn model_npz(model: &ModelFile) -> std::io::Result<Vec<u8>> {
@@ -298,6 +299,15 @@ pub(crate) fn model_npz(model: &ModelFile) -> std::io::Result<Vec<u8>> {
         )?;
         let materials: Vec<&str> = b.member_materials.iter().map(|m| m.as_str()).collect();
         out.strs(&key("member_materials"), &[materials.len()], &materials)?;
+        if !b.strengths.is_empty() {
+            let values: Vec<f64> = b
+                .strengths
+                .iter()
+                .flatten()
+                .map(|s| s.unwrap_or(f64::NAN))
+                .collect();
+            out.f64s(&key("strengths"), &[b.strengths.len(), 2], &values)?;
+        }
     }
     let names: Vec<&str> = model.obstacles.iter().map(|o| o.name.as_str()).collect();
     out.strs("obstacles", &[names.len()], &names)?;
@@ -389,6 +399,15 @@ pub(crate) fn read_model_npz(bytes: &[u8]) -> Result<ModelFile, String> {
         } else {
             Vec::new()
         };
+        let strengths = if npz.contains(&key("strengths")) {
+            npz.f64s(&key("strengths"))?
+                .rows(&key("strengths"), None, 2)?
+                .into_iter()
+                .map(|r| [r[0], r[1]].map(|s: f64| (!s.is_nan()).then_some(s)))
+                .collect()
+        } else {
+            Vec::new()
+        };
         bodies.push(ModelBody {
             name,
             dimension,
@@ -397,6 +416,7 @@ pub(crate) fn read_model_npz(bytes: &[u8]) -> Result<ModelFile, String> {
             patches,
             supports,
             member_materials,
+            strengths,
         });
     }
     let names = npz.strings("obstacles")?.list("obstacles", None)?;
@@ -442,6 +462,7 @@ mod tests {
                         fix: vec!["x".into(), "y".into()],
                     }],
                     member_materials: vec!["steel".into()],
+                    strengths: vec![],
                 },
                 ModelBody {
                     name: "3d".into(),
@@ -454,6 +475,7 @@ mod tests {
                         fix: vec!["z".into()],
                     }],
                     member_materials: vec!["a".into(), "b".into(), "a".into()],
+                    strengths: vec![[Some(2.5e8), None], [None, None], [Some(1.0), Some(2.0)]],
                 },
             ],
             obstacles: vec![ModelObstacle {

@@ -26,6 +26,9 @@ pub struct PictureSettings {
     pub azimuth: Option<Real>,
     /// Camera elevation, degrees (3D; `None`: the default view).
     pub elevation: Option<Real>,
+    /// What colours members and surfaces (`[output] colour`): "stress", "max-stress" or
+    /// "plain" (`None`: "stress").
+    pub colour: Option<String>,
 }
 
 impl Default for PictureSettings {
@@ -40,9 +43,13 @@ impl Default for PictureSettings {
             magnification: None,
             azimuth: None,
             elevation: None,
+            colour: None,
         }
     }
 }
+
+/// The values of `[output] colour`.
+pub const COLOURS: [&str; 3] = ["stress", "max-stress", "plain"];
 
 /// Largest frame side, pixels.
 pub const MAX_FRAME_SIDE: u32 = 8192;
@@ -81,6 +88,13 @@ impl PictureSettings {
                 }
             }
         }
+        if let Some(c) = spec.colour.as_deref() {
+            if !COLOURS.contains(&c) {
+                return Err(format!(
+                    "[output] colour = {c:?}: give \"stress\" (mean member stress at 3D nodes), \"max-stress\" (largest member stress at 3D nodes) or \"plain\""
+                ));
+            }
+        }
         let vtk_encoding = match spec.vtk_format.as_deref() {
             None => VtkEncoding::Binary,
             Some(f) => VtkEncoding::parse(f).ok_or_else(|| {
@@ -97,6 +111,7 @@ impl PictureSettings {
             magnification: spec.magnification,
             azimuth: spec.azimuth,
             elevation: spec.elevation,
+            colour: spec.colour.clone(),
         })
     }
 }

@@ -497,6 +497,8 @@ pub struct OutputSpec {
     pub azimuth: Option<Real>,
     /// Camera elevation, degrees.
     pub elevation: Option<Real>,
+    /// What colours members and surfaces: "stress" (default), "max-stress" or "plain".
+    pub colour: Option<String>,
 }
 
 macro_rules! selector_of {

@@ -31,6 +31,8 @@ pub enum Ran {
 pub struct JobSettings {
     /// Draw PNG frames and `anim.gif` (as `[output] png = true`).
     pub png: bool,
+    /// Write no `anim.gif`, whatever the scene or `png` asks (the CLI's `--no-gif`).
+    pub no_gif: bool,
     /// Write the ParaView files.
     pub vtk: bool,
     /// Run jobs whose complete results are already there.
@@ -79,6 +81,9 @@ pub fn run_job(
     }
     if settings.png {
         world.pictures.ask_png();
+    }
+    if settings.no_gif {
+        world.pictures.gif = false;
     }
     world.pictures.vtk |= settings.vtk;
     on_start(&world);
