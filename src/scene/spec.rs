@@ -482,6 +482,11 @@ pub struct OutputSpec {
     pub azimuth: Option<Real>,
     /// Camera elevation, degrees.
     pub elevation: Option<Real>,
+    /// The node (1-based) whose displacement the load–displacement plot shows (default: the
+    /// largest displacement of any node); see [`crate::scene::PlotSettings`].
+    pub plot_node: Option<usize>,
+    /// The body of `plot_node` (default: the first body).
+    pub plot_body: Option<String>,
 }
 
 macro_rules! selector_of {
