@@ -21,12 +21,4 @@ pub enum PlotError {
         /// The library's message.
         message: String,
     },
-    /// The results folder's summary could not be read (`linkage render`).
-    #[error("cannot read {path}: {message}")]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        message: String,
-    },
 }

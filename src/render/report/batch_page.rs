@@ -103,3 +103,29 @@ fn job_row(row: &Row, files: &JobFiles) -> String {
         plots.join(""),
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_values_and_messages_are_escaped_and_a_job_without_results_has_no_link() {
+        let row = Row {
+            job: "a<b>&c".into(),
+            scene: "a<b>&c".into(),
+            values: vec![("materials.\"x\".area".into(), "<1e-4>".into())],
+            status: "failed: <script>alert(1)</script>".into(),
+            warnings: "deep & <wide>".into(),
+            ..Row::default()
+        };
+        let html = batch_page("batch <1>", &[(&row, JobFiles::default())]);
+        for raw in ["a<b>", "<script>", "<1e-4>", "<wide>", "batch <1>"] {
+            assert!(!html.contains(raw), "{raw} unescaped in {html}");
+        }
+        assert!(html.contains("data-job=\"a&lt;b&gt;&amp;c\""));
+        assert!(html.contains("&lt;script&gt;alert(1)&lt;/script&gt;"));
+        assert!(html.contains("deep &amp; &lt;wide&gt;"));
+        // No results folder: no link to a page that does not exist, no images.
+        assert!(!html.contains("index.html\"") && !html.contains("<img"));
+    }
+}
