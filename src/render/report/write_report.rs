@@ -23,13 +23,19 @@ pub fn write_report(out: &Path, rows: &[Row]) -> std::io::Result<PathBuf> {
             )?;
         }
     }
-    let title = format!(
-        "linkage: {}",
-        out.file_name().map_or_else(
-            || out.display().to_string(),
-            |n| n.to_string_lossy().into_owned()
-        )
-    );
+    // Named after its scenes, not its folder, so two runs of one batch give the same page.
+    let mut scenes: Vec<&str> = Vec::new();
+    for r in rows {
+        let name = if r.scene.is_empty() { &r.job } else { &r.scene };
+        if !scenes.contains(&name.as_str()) {
+            scenes.push(name);
+        }
+    }
+    let title = match scenes.len() {
+        0 => "linkage: an empty batch".to_string(),
+        1..=4 => format!("linkage: {}", scenes.join(", ")),
+        n => format!("linkage: {} and {} more", scenes[..3].join(", "), n - 3),
+    };
     let path = out.join(REPORT);
     write_atomically(&path, batch_page(&title, &jobs).as_bytes())?;
     Ok(path)
