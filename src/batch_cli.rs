@@ -15,6 +15,16 @@ pub fn collect(dir: &Path) -> Result<()> {
         c.parts,
         c.shards
     );
+    let table = dir.join(batch::TABLE);
+    let rows = std::fs::read_to_string(&table)
+        .ok()
+        .and_then(|text| batch::parse_table(&text).ok())
+        .unwrap_or_default();
+    if linkage::render::report::has_pictures(dir, &rows) {
+        let page = linkage::render::report::write_report(dir, &rows)
+            .with_context(|| format!("cannot write the report in {}", dir.display()))?;
+        println!("report {}", page.display());
+    }
     for job in &c.missing {
         println!(
             "missing  {job}: its shard did not finish; run it again (complete jobs are skipped)"

@@ -562,6 +562,12 @@ fn run_scenes(
         None => batch::TABLE.to_string(),
     });
     batch::write_table(&table, &rows)?;
+    // A shard's rows are part of the batch: `linkage collect` writes the report of all.
+    if shard.is_none() && (settings.png || linkage::render::report::has_pictures(out, &rows)) {
+        let page = linkage::render::report::write_report(out, &rows)
+            .with_context(|| format!("cannot write the report in {}", out.display()))?;
+        println!("report {}", page.display());
+    }
     if failed > 0 {
         let noun = if mine.iter().any(|j| j.variant.is_some()) {
             "job"

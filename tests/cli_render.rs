@@ -92,14 +92,16 @@ fn run_png_vtk_then_render_again_with_other_options() {
     assert_eq!(listing(&dir.join("png")), ["0001.png", "notes.txt"]);
     assert_eq!(
         listing(out.path()),
-        ["batch.csv", "paper_square"],
+        ["batch.csv", "index.html", "paper_square"],
         "no staging folder left"
     );
     assert_eq!(
         listing(&dir),
         [
             "anim.gif",
+            "index.html",
             "model.json",
+            "plots",
             "png",
             "steps",
             "summary.json",

@@ -79,15 +79,16 @@ fn a_users_files_in_the_results_folder_survive_a_rerun() {
     let good = solved_truss(dir.path(), &out);
     let folder = out.join("truss");
     std::fs::write(folder.join("notes.txt"), "the second design").unwrap();
-    std::fs::create_dir(folder.join("plots")).unwrap();
-    std::fs::write(folder.join("plots/u.csv"), "1,2").unwrap();
+    // (`plots/` is linkage's own since runs draw plots: a user's folder has another name.)
+    std::fs::create_dir(folder.join("analysis")).unwrap();
+    std::fs::write(folder.join("analysis/u.csv"), "1,2").unwrap();
     run(&good, &out, &|| {}).unwrap();
     assert_eq!(
         std::fs::read_to_string(folder.join("notes.txt")).unwrap(),
         "the second design"
     );
     assert_eq!(
-        std::fs::read_to_string(folder.join("plots/u.csv")).unwrap(),
+        std::fs::read_to_string(folder.join("analysis/u.csv")).unwrap(),
         "1,2"
     );
     assert!(folder.join("steps/0004.json").is_file());

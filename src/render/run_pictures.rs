@@ -258,4 +258,15 @@ impl DrawResults for PictureWriter {
         draw_run(run, dir, &RenderOptions::from_settings(&world.pictures))?;
         Ok(())
     }
+
+    fn plot(
+        &self,
+        world: &World,
+        run: &RunResults,
+        summary: &crate::scene::Summary,
+        dir: &Path,
+    ) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+        crate::render::plots::plot_run(summary, run, &world.plots, dir)?;
+        Ok(())
+    }
 }

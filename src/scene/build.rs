@@ -15,7 +15,7 @@ use crate::scene::prepared_body::prepared_geometry;
 use crate::scene::pressures::add_pressure;
 use crate::scene::selector::{select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
-use crate::scene::{OutputSettings, PictureSettings, ResultFormat, World};
+use crate::scene::{OutputSettings, PictureSettings, PlotSettings, ResultFormat, World};
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -261,6 +261,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         contact.friction =
             friction_settings(c.get_ref(), &names, c.span()).map_err(|(span, e)| at(span, e))?;
     }
+    let plots = PlotSettings::from_spec(&spec.output, &bodies).map_err(|e| at(output_span, e))?;
     let members = bodies.iter().map(|b| b.members.len()).sum();
     let output = OutputSettings {
         format: format.unwrap_or(ResultFormat::default_for(members)),
@@ -276,6 +277,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
         bodies,
         output,
         pictures,
+        plots,
         source: path.to_path_buf(),
         scene_digest: crate::scene::scene_digest(text),
         prepared,

@@ -162,7 +162,7 @@ fn run_in(
     summary.phases.numeric += times.numeric;
     summary.phases.solve += times.solve;
     summary.phases.contact_query += query;
-    write_after_steps(world, kept, staging, draw, &mut summary.phases)?;
+    write_after_steps(world, kept, staging, draw, &mut summary)?;
     write_json(&staging.join("summary.json"), &summary, true)?;
     let target = destination(final_dir, stopped.is_none());
     publish(staging, &target).map_err(write_err(&target))?;

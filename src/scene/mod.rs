@@ -8,6 +8,7 @@ pub use self::check::{
 pub use self::driver::{run, run_into, run_until, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
+pub use self::plot_settings::{PlotNode, PlotSettings};
 pub use self::prepared_body::{prepare_file, read_outline, write_prepared};
 pub use self::result_format::{ResultFormat, NPZ_ABOVE_MEMBERS};
 pub use self::results::{
@@ -42,6 +43,7 @@ mod npz_files;
 mod obstacles;
 pub mod paper_files;
 mod pictures;
+mod plot_settings;
 mod prepared_body;
 mod pressures;
 pub mod publish;

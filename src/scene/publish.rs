@@ -22,6 +22,8 @@ pub const WRITTEN: &[&str] = &[
     "vtk",
     "png",
     "anim.gif",
+    "plots",
+    "index.html",
 ];
 
 /// The suffix of the folder a failed run's results go to when complete results exist.

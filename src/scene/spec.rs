@@ -499,6 +499,11 @@ pub struct OutputSpec {
     pub elevation: Option<Real>,
     /// What colours members and surfaces: "stress" (default), "max-stress" or "plain".
     pub colour: Option<String>,
+    /// The node (1-based) whose displacement the load–displacement plot shows (default: the
+    /// largest displacement of any node); see [`crate::scene::PlotSettings`].
+    pub plot_node: Option<usize>,
+    /// The body of `plot_node` (default: the first body).
+    pub plot_body: Option<String>,
 }
 
 macro_rules! selector_of {

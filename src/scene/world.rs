@@ -2,7 +2,7 @@
 
 use crate::contact::{ContactSettings, Obstacle};
 use crate::linkage::{Body, Schedule};
-use crate::scene::{PictureSettings, ResultFormat};
+use crate::scene::{PictureSettings, PlotSettings, ResultFormat};
 use crate::Real;
 use std::path::PathBuf;
 
@@ -56,6 +56,8 @@ pub struct World {
     pub output: OutputSettings,
     /// Pictures and VTK files to write.
     pub pictures: PictureSettings,
+    /// What the plots drawn with the pictures show (`[output] plot_node`).
+    pub plots: PlotSettings,
     /// The scene file it came from.
     pub source: PathBuf,
     /// [`crate::scene::scene_digest`] of the text it was built from (a sweep's variant: its

@@ -5,7 +5,7 @@ use crate::scene::atomic_file::write_atomically;
 use crate::scene::model_file::ModelFile;
 use crate::scene::npz_files::{model_npz, step_npz};
 use crate::scene::result_format::ResultFormat;
-use crate::scene::results::{PhaseSeconds, StepResult};
+use crate::scene::results::{StepResult, Summary};
 use crate::scene::run_error::RunError;
 use crate::scene::run_results::{step_digits, step_stem, RunResults};
 use crate::scene::vtk::write_vtk;
@@ -25,6 +25,18 @@ pub trait DrawResults: Sync {
         run: &RunResults,
         dir: &Path,
     ) -> Result<(), Box<dyn std::error::Error + Send + Sync>>;
+
+    /// Draw the plots of the run's process (`summary`: every solved step; `run`: the stored
+    /// ones) into `dir`, after [`DrawResults::draw`]; by default none.
+    fn plot(
+        &self,
+        _world: &World,
+        _run: &RunResults,
+        _summary: &Summary,
+        _dir: &Path,
+    ) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+        Ok(())
+    }
 }
 
 /// Whether the writers after the load steps (VTK files, pictures by `draw`) need the stored
@@ -95,16 +107,17 @@ fn write_bytes(path: &Path, bytes: std::io::Result<Vec<u8>>) -> Result<(), RunEr
     write_atomically(path, &bytes.map_err(err)?).map_err(err)
 }
 
-/// Write `model.json` (or `model.npz`) of `world`, then VTK files and pictures as
+/// Write `model.json` (or `model.npz`) of `world`, then VTK files, pictures and plots as
 /// `world.pictures` asks, into `dir`, from the stored `steps` (kept when [`keeps_steps`] says
-/// they are needed).
+/// they are needed) and `summary` (its phases get the time spent).
 pub(crate) fn write_after_steps(
     world: &World,
     steps: Vec<StepResult>,
     dir: &Path,
     draw: Option<&dyn DrawResults>,
-    phases: &mut PhaseSeconds,
+    summary: &mut Summary,
 ) -> Result<(), RunError> {
+    let phases = &mut summary.phases;
     let t = Instant::now();
     let format = world.output.format;
     let path = dir.join(format.model_file());
@@ -139,7 +152,12 @@ pub(crate) fn write_after_steps(
                 path: dir.to_path_buf(),
                 source,
             })?;
-        phases.drawing += t.elapsed().as_secs_f64();
+        draw.plot(world, &run, summary, dir)
+            .map_err(|source| RunError::Draw {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+        summary.phases.drawing += t.elapsed().as_secs_f64();
     }
     Ok(())
 }

@@ -10,7 +10,7 @@ pub use self::slurm::{write_slurm, SlurmOptions, SlurmPlan};
 pub use self::table::{parse_table, table_csv, write_table, Row, TABLE};
 
 mod collect;
-mod csv;
+pub(crate) mod csv;
 mod error;
 mod jobs;
 mod row;

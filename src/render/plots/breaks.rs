@@ -1,0 +1,32 @@
+//! Members broken against the load factor at which each broke.
+
+use crate::render::plots::{Chart, Series};
+use crate::scene::Summary;
+
+/// The chart `breaks`: one point per break in the order they happened, at the load factor of
+/// the break and the number of members broken so far (all bodies); `None` without breaks.
+pub fn breaks(summary: &Summary) -> Option<Chart> {
+    if summary.breaks.is_empty() {
+        return None;
+    }
+    let mut s = Series::new("broken members");
+    for (k, b) in summary.breaks.iter().enumerate() {
+        s.push(
+            b.load_factor,
+            (k + 1) as f64,
+            format!("step {}, body '{}' member {}", b.step, b.body, b.member),
+        );
+    }
+    Some(Chart {
+        name: "breaks".into(),
+        title: format!("{}: members broken against load factor", summary.scene),
+        x_label: "load factor at the break (-)".into(),
+        y_label: "members broken (count)".into(),
+        columns: ("load_factor".into(), "broken_members".into()),
+        log_y: false,
+        legend: false,
+        one_colour: false,
+        integer: (false, true),
+        series: vec![s],
+    })
+}

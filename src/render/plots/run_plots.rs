@@ -1,0 +1,35 @@
+//! Every plot of one run, written to `plots/` of its results folder.
+
+use crate::render::plots::{
+    breaks, contact_forces, load_displacement, reaction, residuals, PlotError, WrittenPlot,
+};
+use crate::scene::{PlotSettings, RunResults, Summary};
+use std::path::Path;
+
+/// The folder of a run's plots, in its results folder.
+pub const PLOTS: &str = "plots";
+
+/// Write the plots of the run with `summary` and stored steps `run` into `dir/plots/`: always
+/// the load–displacement curve (and with `settings.node` the reaction total); the contact
+/// forces when a pair touched, the Newton residuals when a step was nonlinear, the breaks when
+/// members broke. Each as PNG, SVG and the CSV of its points, written atomically.
+pub fn plot_run(
+    summary: &Summary,
+    run: &RunResults,
+    settings: &PlotSettings,
+    dir: &Path,
+) -> Result<Vec<WrittenPlot>, PlotError> {
+    let plots = dir.join(PLOTS);
+    std::fs::create_dir_all(&plots).map_err(|source| PlotError::Write {
+        path: plots.clone(),
+        source,
+    })?;
+    let mut charts = vec![load_displacement(summary, run, settings.node.as_ref())];
+    if settings.node.is_some() {
+        charts.push(reaction(&summary.scene, run));
+    }
+    charts.extend(contact_forces(summary));
+    charts.extend(residuals(summary));
+    charts.extend(breaks(summary));
+    charts.iter().map(|c| c.write(&plots)).collect()
+}

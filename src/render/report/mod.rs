@@ -1,0 +1,11 @@
+//! The HTML report of a batch: `DIR/index.html` with a row per job and a page per job with
+//! every frame; plain HTML and CSS with relative links, read from disk without a network.
+
+pub use self::write_report::{has_pictures, write_report, REPORT};
+
+mod batch_page;
+mod facts;
+mod html;
+mod job_files;
+mod scene_page;
+mod write_report;
