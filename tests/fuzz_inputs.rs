@@ -614,8 +614,11 @@ fn find_null(value: &serde_json::Value, at: String) -> Option<String> {
             .iter()
             .enumerate()
             .find_map(|(k, v)| find_null(v, format!("{at}[{k}]"))),
+        // model.json's `strengths` holds null for "no strength" (a material without a
+        // compressive or tensile strength); the scene's strengths are checked finite.
         serde_json::Value::Object(map) => map
             .iter()
+            .filter(|(k, _)| k.as_str() != "strengths")
             .find_map(|(k, v)| find_null(v, format!("{at}.{k}"))),
         _ => None,
     }

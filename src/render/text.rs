@@ -4,8 +4,9 @@ use crate::render::Rgb;
 use std::sync::OnceLock;
 use tiny_skia::Pixmap;
 
-/// DejaVu Sans cut down to ASCII and a few symbols (licence: `assets/fonts/LICENSE-DejaVu.txt`).
-const FONT_FILE: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
+/// DejaVu Sans cut down to ASCII and a few symbols (licence: `assets/fonts/LICENSE-DejaVu.txt`):
+/// the frames' and the plots' font.
+pub(crate) const FONT_FILE: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
 
 fn font() -> &'static fontdue::Font {
     static FONT: OnceLock<fontdue::Font> = OnceLock::new();

@@ -12,9 +12,9 @@ use std::sync::OnceLock;
 /// Plot width and height, pixels.
 pub const PLOT_SIZE: (u32, u32) = (800, 500);
 
-/// The bundled DejaVu Sans (the frames' font, `assets/fonts/`): plotters is built without
-/// system fonts, so a machine without any draws the same text.
-const FONT_FILE: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans-subset.ttf");
+// The bundled DejaVu Sans (the frames' font): plotters is built without system fonts, so a
+// machine without any draws the same text.
+use crate::render::text::FONT_FILE;
 
 /// The font family plotters is asked for; registered once from [`FONT_FILE`].
 const FAMILY: &str = "sans-serif";
