@@ -205,6 +205,38 @@ fn a_fracture_scene_gets_one_point_per_break_at_its_load_factor() {
     }
 }
 
+/// A softening scene: its teeth are recorded in `breaks` but are not breaks; the plot counts
+/// a member when its last tooth breaks it, and the report says breaks and teeth apart.
+#[test]
+fn softening_teeth_are_not_counted_as_breaks() {
+    let out = tempfile::tempdir().unwrap();
+    run_png(&[scene("notched_beam")], out.path());
+    let dir = out.path().join("notched_beam");
+    let s = summary(&dir);
+    let all = s["breaks"].as_array().unwrap();
+    let broke: Vec<&Value> = all.iter().filter(|b| b.get("tooth").is_none()).collect();
+    let teeth = all.len() - broke.len();
+    assert!(
+        !broke.is_empty() && teeth > 0,
+        "{} breaks, {teeth} teeth",
+        broke.len()
+    );
+    let p = points(&dir, "breaks", ("load_factor", "broken_members"));
+    assert_eq!(p.len(), broke.len());
+    for (k, (point, b)) in p.iter().zip(&broke).enumerate() {
+        assert_eq!(point.1, b["load_factor"].as_f64().unwrap());
+        assert_eq!(point.2, (k + 1) as f64);
+    }
+    let report = std::fs::read_to_string(out.path().join("index.html")).unwrap();
+    assert!(
+        report.contains(&format!(
+            "({} broke in all), {teeth} softening teeth passed",
+            broke.len()
+        )),
+        "{report}"
+    );
+}
+
 /// `scenes/paper_square.toml` with `[output]` lines `extra`, written into `dir`.
 fn square_with(dir: &Path, extra: &str) -> PathBuf {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");

@@ -4,13 +4,19 @@ use crate::render::plots::{Chart, Series};
 use crate::scene::Summary;
 
 /// The chart `breaks`: one point per break in the order they happened, at the load factor of
-/// the break and the number of members broken so far (all bodies); `None` without breaks.
+/// the break and the number of members broken so far (all bodies); `None` without breaks. A
+/// softening member's teeth are not breaks: it counts when its last tooth breaks it.
 pub fn breaks(summary: &Summary) -> Option<Chart> {
-    if summary.breaks.is_empty() {
+    let broken: Vec<_> = summary
+        .breaks
+        .iter()
+        .filter(|b| b.tooth.is_none())
+        .collect();
+    if broken.is_empty() {
         return None;
     }
     let mut s = Series::new("broken members");
-    for (k, b) in summary.breaks.iter().enumerate() {
+    for (k, b) in broken.into_iter().enumerate() {
         s.push(
             b.load_factor,
             (k + 1) as f64,

@@ -88,9 +88,17 @@ impl Facts {
         if !row.broken.is_empty() {
             members.push_str(&format!(", {} broken", row.broken));
         }
-        if let Some(n) = summary.map(|s| s.breaks.len()).filter(|n| *n > 0) {
-            // A collapse's breaks come after the last stored step: say them all.
-            members.push_str(&format!(" ({n} broke in all)"));
+        if let Some(s) = summary {
+            // A collapse's breaks come after the last stored step: say them all. A softening
+            // member's teeth are not breaks.
+            let teeth = s.breaks.iter().filter(|b| b.tooth.is_some()).count();
+            let broke = s.breaks.len() - teeth;
+            if broke > 0 {
+                members.push_str(&format!(" ({broke} broke in all)"));
+            }
+            if teeth > 0 {
+                members.push_str(&format!(", {teeth} softening teeth passed"));
+            }
         }
         let contact = summary
             .and_then(|s| s.steps.last())
