@@ -203,6 +203,13 @@ pub struct StepSummary {
     /// Members broken so far, all bodies (absent without breaking members).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub broken: Option<usize>,
+    /// The member stress of largest magnitude, Pa, signed (absent without members).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_stress: Option<Real>,
+    /// The largest |σ| over its member's strength in that sense, over the members whose
+    /// material has one (absent when none has).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stress_ratio: Option<Real>,
 }
 
 /// Size of one body, as reported in `summary.json`.

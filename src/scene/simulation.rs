@@ -362,6 +362,8 @@ fn empty_summary(step: usize, load_factor: Real) -> StepSummary {
         warnings: Vec::new(),
         contact_forces: Vec::new(),
         broken: None,
+        peak_stress: None,
+        stress_ratio: None,
     }
 }
 

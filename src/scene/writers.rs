@@ -107,11 +107,27 @@ fn write_bytes(path: &Path, bytes: std::io::Result<Vec<u8>>) -> Result<(), RunEr
     write_atomically(path, &bytes.map_err(err)?).map_err(err)
 }
 
-/// Write `model.json` (or `model.npz`) of `world`, then VTK files, pictures and plots as
-/// `world.pictures` asks, into `dir`, from the stored `steps` (kept when [`keeps_steps`] says
-/// they are needed) and `summary` (its phases get the time spent).
+/// Write `model.json` (or `model.npz`) of `world` into `dir` and return it with the seconds
+/// spent. It depends on nothing solved, so the driver writes it while the steps are solved.
+pub(crate) fn write_model(world: &World, dir: &Path) -> Result<(ModelFile, f64), RunError> {
+    let t = Instant::now();
+    let path = dir.join(world.output.format.model_file());
+    let model = ModelFile::new(world);
+    match world.output.format {
+        ResultFormat::Json => {
+            write_json(&path, &model, false)?;
+        }
+        ResultFormat::Npz => write_bytes(&path, model_npz(&model))?,
+    }
+    Ok((model, t.elapsed().as_secs_f64()))
+}
+
+/// Write the VTK files, pictures and plots `world.pictures` asks for into `dir`, from `model`
+/// (written by [`write_model`]), the stored `steps` (kept when [`keeps_steps`] says they are
+/// needed) and `summary` (its phases get the time spent).
 pub(crate) fn write_after_steps(
     world: &World,
+    model: ModelFile,
     steps: Vec<StepResult>,
     dir: &Path,
     draw: Option<&dyn DrawResults>,
@@ -119,15 +135,6 @@ pub(crate) fn write_after_steps(
 ) -> Result<(), RunError> {
     let phases = &mut summary.phases;
     let t = Instant::now();
-    let format = world.output.format;
-    let path = dir.join(format.model_file());
-    let model = ModelFile::new(world);
-    match format {
-        ResultFormat::Json => {
-            write_json(&path, &model, false)?;
-        }
-        ResultFormat::Npz => write_bytes(&path, model_npz(&model))?,
-    }
     let drawing = draw.filter(|_| world.pictures.png || world.pictures.gif);
     if !world.pictures.vtk && drawing.is_none() {
         phases.writing += t.elapsed().as_secs_f64();

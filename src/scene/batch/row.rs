@@ -3,7 +3,8 @@
 
 use crate::scene::batch::jobs::Job;
 use crate::scene::batch::table::{contact_column, Row};
-use crate::scene::{StepResult, StoredRun, Summary, World};
+use crate::scene::peak_stress::peak_stress;
+use crate::scene::{StoredRun, Summary, World};
 use crate::Real;
 use std::path::Path;
 
@@ -86,48 +87,17 @@ pub fn job_row(job: &Job, status: String, results: Option<&Path>, world: Option<
         .flat_map(|s| s.warnings.iter().map(String::as_str))
         .collect();
     row.warnings = warnings.join("; ");
-    if let Some(step) = StoredRun::open(dir)
-        .ok()
-        .and_then(|run| run.steps.last().and_then(|&k| run.read_step(k).ok()))
-    {
-        let (peak, ratio) = peak_stress(&step, world);
-        row.peak_stress = peak.map(|p| format!("{p:e}")).unwrap_or_default();
-        row.stress_ratio = ratio.map(|r| format!("{r:e}")).unwrap_or_default();
-    }
+    // The summary carries the last step's peak stress; results written before it did are read
+    // back (the whole last step file, which costs a second on a million-member body).
+    let (peak, ratio) = match summary.steps.last() {
+        Some(last) if last.peak_stress.is_some() => (last.peak_stress, last.stress_ratio),
+        _ => StoredRun::open(dir)
+            .ok()
+            .and_then(|run| run.steps.last().and_then(|&k| run.read_step(k).ok()))
+            .map(|step| peak_stress(&step, world))
+            .unwrap_or_default(),
+    };
+    row.peak_stress = peak.map(|p| format!("{p:e}")).unwrap_or_default();
+    row.stress_ratio = ratio.map(|r| format!("{r:e}")).unwrap_or_default();
     row
-}
-
-/// The member stress of largest magnitude in `step` (Pa, signed), and the largest |σ| over the
-/// strength of its member's material in that sense (tensile for σ > 0, compressive for σ < 0),
-/// over the members of `world` that have one.
-fn peak_stress(step: &StepResult, world: Option<&World>) -> (Option<Real>, Option<Real>) {
-    let mut peak: Option<Real> = None;
-    let mut ratio: Option<Real> = None;
-    for body in &step.bodies {
-        let model = world.and_then(|w| w.bodies.iter().find(|b| b.name == body.name));
-        for (m, &s) in body.stresses.iter().enumerate() {
-            if peak.is_none_or(|p| s.abs() > p.abs()) {
-                peak = Some(s);
-            }
-            let material = model.and_then(|b| {
-                b.members
-                    .get(m)
-                    .and_then(|member| b.materials.get(member.material))
-            });
-            let strength = material.and_then(|mat| {
-                if s >= 0.0 {
-                    mat.tensile_strength
-                } else {
-                    mat.compressive_strength
-                }
-            });
-            if let Some(limit) = strength.filter(|l| *l > 0.0) {
-                let r = s.abs() / limit;
-                if ratio.is_none_or(|q| r > q) {
-                    ratio = Some(r);
-                }
-            }
-        }
-    }
-    (peak, ratio)
 }
