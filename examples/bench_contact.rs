@@ -7,7 +7,9 @@
 //! 2. Two 3D boxes of about 20,000 nodes each pressed together (the lower one standing on its
 //!    base, the upper one held vertically by contact alone): time per load step split into
 //!    assembly, factorization, solves and contact queries, with Newton and contact iterations
-//!    and the equilibrium residual. Both bodies ask for the direct solver: above 30,000 free
+//!    and the equilibrium residual; then the whole run (set-up and steps), wall and CPU time
+//!    (the CPU time of the process, both cores: on a shared machine it shows the work apart
+//!    from the waiting). Both bodies ask for the direct solver: above 30,000 free
 //!    DOFs `auto` would pick conjugate gradients on the coupled system, and only bodies with a
 //!    factorization are condensed.
 //! 3. With `--friction` (the query timings are then left out): the same pair with μ = 0
@@ -101,9 +103,11 @@ total_force = [0.0, -500.0, 0.0]
         law = friction.map_or(String::new(), |mu| format!("friction = {mu}")),
     );
     let world = build_world(&scene, Path::new("bench_pair.toml")).expect("a valid scene");
-    let t = Instant::now();
+    let start = Instant::now();
+    let cpu_start = cpu_seconds();
     let mut sim = Simulation::new(&world).expect("builds");
-    let setup = t.elapsed().as_secs_f64();
+    let setup = start.elapsed().as_secs_f64();
+    let cpu_setup = cpu_seconds().zip(cpu_start).map(|(a, b)| a - b);
     // Phase times of the contact solver so far: assembly (and residuals), ordering and
     // symbolic analysis, factorization (with the compliance), solves, contact queries.
     let phases = |sim: &Simulation| -> [f64; 5] {
@@ -137,6 +141,9 @@ total_force = [0.0, -500.0, 0.0]
         p0[2],
         p0[3]
     );
+    if let Some(cpu) = cpu_setup {
+        println!("       set-up CPU (both cores, this process) {cpu:.2} s");
+    }
     let mut before = p0;
     for step in 0..=STEPS {
         let t = Instant::now();
@@ -166,6 +173,25 @@ total_force = [0.0, -500.0, 0.0]
             }
         );
     }
+    let cpu = cpu_seconds()
+        .zip(cpu_start)
+        .map_or(String::new(), |(a, b)| format!(", CPU {:.2} s", a - b));
+    println!(
+        "       whole run (set-up and {STEPS} steps): {:.2} s{cpu}",
+        start.elapsed().as_secs_f64()
+    );
+}
+
+/// User plus system CPU time of this process so far, s (Linux `/proc/self/stat`; `None`
+/// elsewhere): on a shared machine it shows the work apart from the waiting.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The fields after the command name (which is in parentheses and may hold spaces).
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
+    // The kernel's USER_HZ is 100 on every Linux the project runs on.
+    Some(ticks / 100.0)
 }
 
 /// Load steps of the pair benchmark: the first includes the one-off factorizations.

@@ -1039,6 +1039,112 @@ max_iterations = 100
     }
 }
 
+/// Two boxes of 4 × 4 × 4 cells (the lower on its base, the upper held sideways on two
+/// vertical lines and pushed down by 1000 N), the upper `gap` above the lower.
+fn stacked_boxes(gap: f64) -> String {
+    format!(
+        r#"
+name = "stacked_boxes"
+steps = 2
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "lower"
+box_lattice = {{ size = [1.0, 1.0, 1.0], cells = [4, 4, 4] }}
+solver = "direct"
+[[bodies.supports]]
+on_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }}
+fix = ["x", "y", "z"]
+[[bodies]]
+name = "upper"
+box_lattice = {{ size = [1.0, 1.0, 1.0], cells = [4, 4, 4] }}
+solver = "direct"
+offset = [0.0, {top}, 0.0]
+[[bodies.supports]]
+on_line = {{ point = [0.0, {top}, 0.0], direction = [0.0, 1.0, 0.0] }}
+fix = ["x", "z"]
+[[bodies.supports]]
+on_line = {{ point = [1.0, {top}, 1.0], direction = [0.0, 1.0, 0.0] }}
+fix = ["x", "z"]
+[[bodies.loads]]
+on_plane = {{ point = [0.0, {load}, 0.0], normal = [0.0, 1.0, 0.0] }}
+total_force = [0.0, -1000.0, 0.0]
+[contact]
+max_iterations = 100
+"#,
+        top = 1.0 + gap,
+        load = 2.0 + gap,
+    )
+}
+
+/// Boxes face to face: the condensed path's candidates of each are its 5 × 5 touching face and,
+/// as the other body's nodes at the face's edge press the side patches there, the 16 nodes of
+/// the side row next to the face; the rows farther down are not candidates.
+#[test]
+fn candidates_are_the_touching_face_and_its_patches() {
+    let world = build_world(&stacked_boxes(0.0), Path::new("stacked.toml")).unwrap();
+    let sim = Simulation::new(&world).unwrap();
+    for body in 0..2 {
+        let candidates = sim
+            .contact()
+            .and_then(|c| c.candidate_nodes(body))
+            .expect("condensed");
+        assert_eq!(candidates, 25 + 16, "body {body}");
+    }
+}
+
+/// The disks of `scenes/two_disks.toml` with the left one 1 cm farther left (more than the
+/// candidates' margin of a quarter member, less than two members): no node is a candidate at
+/// first; the disks, held only by contact along x, move together, touch, the candidates of
+/// both grow to the nodes the contacts reach, and the answer is the coupled solve's at every
+/// step (displacements to 1e-6 of the largest; 2.5e-9 seen).
+#[test]
+fn contacts_between_bodies_beyond_the_candidates_widen_them() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/two_disks.toml"),
+    )
+    .unwrap();
+    let apart = text
+        .replace("offset = [-0.1, 0.0]", "offset = [-0.11, 0.0]")
+        .replace("nearest = [-0.2, 0.0]", "nearest = [-0.21, 0.0]");
+    assert_ne!(apart, text, "the scene moved the left disk");
+    let mut world = build_world(&apart, Path::new("two_disks_apart.toml")).unwrap();
+    let mut sim = Simulation::new(&world).unwrap();
+    let count = |sim: &Simulation, body: usize| {
+        sim.contact()
+            .and_then(|c| c.candidate_nodes(body))
+            .expect("condensed")
+    };
+    assert_eq!((count(&sim, 0), count(&sim, 1)), (0, 0), "nothing is near");
+    let condensed: Vec<_> = (0..=world.steps).map(|k| sim.step(k).unwrap()).collect();
+    for body in 0..2 {
+        assert!(count(&sim, body) >= 3, "body {body} grew to its contacts");
+    }
+    world.contact.condense = false;
+    let coupled = run_all(&world);
+    for ((a, _), (b, _)) in condensed.iter().zip(&coupled).skip(1) {
+        for body in 0..2 {
+            let largest = b.bodies[body]
+                .displacements
+                .iter()
+                .flat_map(|u| u.iter())
+                .fold(0.0_f64, |m, x| m.max(x.abs()));
+            assert!(largest > 0.005, "the disks moved together: {largest} m");
+            for (ua, ub) in a.bodies[body]
+                .displacements
+                .iter()
+                .zip(&b.bodies[body].displacements)
+            {
+                for (x, y) in ua.iter().zip(ub) {
+                    assert!((x - y).abs() <= 1e-6 * largest, "body {body}: {x} vs {y}");
+                }
+            }
+        }
+    }
+}
+
 /// The bar of `bar_pressed_onto_floor_sinks_force_over_penalty` pushed into the floor by a
 /// prescribed displacement d of its top instead of a force: the bar (k = E A / L) and the
 /// penalty κ act in series, so the foot sinks p = d k / (k + κ) and the floor pushes back with

@@ -34,9 +34,17 @@ pub const SHELL_REACH_MEMBERS: Real = 3.0;
 /// obstacle with its own nodes there; see [`Geometry::query`]).
 pub const SHARP_REACH_MEMBERS: Real = 2.0;
 
-/// Candidates lie within this many mean member lengths of another body's bounding box or of
-/// an obstacle (anywhere along its travel).
+/// Candidates lie within this many mean member lengths of an obstacle (anywhere along its
+/// travel).
 const MARGIN_MEMBERS: Real = 2.0;
+
+/// Candidates lie within this many mean member lengths of another body's bounding box (with
+/// the nodes of their surface patches, see [`candidate_nodes`]). Every candidate costs the
+/// condensed path's set-up dearly (its compliance is dense: on the contact benchmark the
+/// factorization with the candidates last grows about as the square of their number), so the
+/// margin covers round-off and small moves only; a node that travels farther and touches is
+/// added then (`CondensedSolver::grow`).
+const BODY_MARGIN_MEMBERS: Real = 0.25;
 
 /// A deformed boundary loop and its bounding box `[x_min, y_min, x_max, y_max]`, m.
 type Polygon = (Vec<Vector3<Real>>, [Real; 4]);
@@ -619,6 +627,10 @@ fn min_depth(parts: &[BodyPart]) -> Real {
 /// Per body, the nodes that may touch something: surface nodes (3D: of its patches; 2D: of its
 /// boundary loop; all nodes when it has neither) near another body's bounding box or near an
 /// obstacle anywhere along its travel (`travels`: per obstacle, offsets sampled along it, m).
+///
+/// A node near another body comes with the other nodes of its patches (2D: its neighbours
+/// along the loop): a node of the other body pressing near it presses one of those patches,
+/// whose nodes are then in the contact's row (at the edge of a face, the side's patches).
 pub(crate) fn candidate_nodes(
     bodies: &[Body],
     geometry: &Geometry,
@@ -627,6 +639,10 @@ pub(crate) fn candidate_nodes(
     let margin: Vec<Real> = bodies
         .iter()
         .map(|b| MARGIN_MEMBERS * 100.0 * penetration_tolerance(b))
+        .collect();
+    let body_margin: Vec<Real> = bodies
+        .iter()
+        .map(|b| BODY_MARGIN_MEMBERS * 100.0 * penetration_tolerance(b))
         .collect();
     let boxes: Vec<(Vector3<Real>, Vector3<Real>)> = bodies
         .iter()
@@ -648,12 +664,14 @@ pub(crate) fn candidate_nodes(
             (None, None) => (0..body.nodes.len()).collect(),
         };
         let mut mark = vec![false; body.nodes.len()];
+        let mut near = vec![false; body.nodes.len()];
         for node in surface {
             let x = body.nodes[node];
             let near_body = boxes.iter().enumerate().any(|(o, (lo, hi))| {
-                let m = margin[b].max(margin[o]);
+                let m = body_margin[b].max(body_margin[o]);
                 o != b && (0..3).all(|k| x[k] >= lo[k] - m && x[k] <= hi[k] + m)
             });
+            near[node] = near_body;
             let near_obstacle = || {
                 travels.iter().enumerate().any(|(o, offsets)| {
                     offsets.iter().any(|offset| {
@@ -665,6 +683,23 @@ pub(crate) fn candidate_nodes(
                 })
             };
             mark[node] = near_body || near_obstacle();
+        }
+        match (&geometry.patch_surfaces[b], &geometry.surfaces[b]) {
+            (Some(p), _) => {
+                for patch in p.patches.iter().filter(|t| t.iter().any(|&i| near[i])) {
+                    patch.iter().for_each(|&i| mark[i] = true);
+                }
+            }
+            (None, Some(s)) => {
+                let n = s.nodes.len();
+                for (i, &node) in s.nodes.iter().enumerate() {
+                    if near[node] {
+                        mark[s.nodes[(i + 1) % n]] = true;
+                        mark[s.nodes[(i + n - 1) % n]] = true;
+                    }
+                }
+            }
+            (None, None) => {}
         }
         out.push(mark);
     }
