@@ -505,3 +505,101 @@ fn a_block_on_a_slope_holds_while_tan_theta_is_below_mu_and_slides_above() {
         }
     }
 }
+
+/// Two boxes of 5³ nodes pressed together with μ = 0.3 (the contact benchmark's pair, small),
+/// then the upper one sheared 0.1 mm along x per step by two held lines. At the shear's onset
+/// every contact's trial force is far beyond μ N and Newton's full steps turn the tangential
+/// forces back and forth; the condensed Newton holds such contacts sticking until it has
+/// converged and then lets go those beyond μ N (`FrictionHistory::held`). It must cross every
+/// step whole on the condensed path (no cut, no fall to the coupled path; before this, step 2
+/// was cut and fell to the coupled path), to an equilibrium (residual at most 1e-9) carrying
+/// the load (1e-6), equal and opposite between the bodies (1e-9), with the coupled path's
+/// normal totals (1e-6).
+#[test]
+fn a_sheared_pair_converges_whole_steps_on_the_condensed_path_to_the_exact_law() {
+    let scene = r#"
+name = "sheared_pair"
+steps = 3
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "lower"
+box_lattice = { size = [0.2, 0.1, 0.2], cells = [4, 4, 4] }
+[[bodies.supports]]
+on_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
+fix = ["x", "y", "z"]
+[[bodies]]
+name = "upper"
+box_lattice = { size = [0.2, 0.1, 0.2], cells = [4, 4, 4] }
+offset = [0.0, 0.1, 0.0]
+[[bodies.supports]]
+on_line = { point = [0.0, 0.1, 0.0], direction = [0.0, 1.0, 0.0] }
+fix = ["x", "z"]
+displacement = [1e-4, 0.0, 0.0]
+schedule = [0.0, 1.0, 2.0]
+[[bodies.supports]]
+on_line = { point = [0.2, 0.1, 0.2], direction = [0.0, 1.0, 0.0] }
+fix = ["x", "z"]
+displacement = [1e-4, 0.0, 0.0]
+schedule = [0.0, 1.0, 2.0]
+[[bodies.loads]]
+on_plane = { point = [0.0, 0.2, 0.0], normal = [0.0, 1.0, 0.0] }
+total_force = [0.0, -500.0, 0.0]
+[contact]
+friction = 0.3
+"#;
+    let mut world =
+        linkage::scene::build_world(scene, Path::new("sheared_pair.toml")).expect("a valid scene");
+    let mut sim = Simulation::new(&world).expect("builds");
+    assert!(sim.contact().is_some_and(|c| c.is_condensed()));
+    let mut condensed = Vec::new();
+    for k in 0..=world.steps {
+        let (result, summary) = sim.step(k).expect("solves");
+        assert!(
+            sim.contact().is_some_and(|c| c.is_condensed()),
+            "step {k} left the condensed path"
+        );
+        assert_eq!(summary.cuts, 0, "step {k} was cut");
+        condensed.push((result, summary));
+    }
+    for (k, (_, sa)) in condensed.iter().enumerate().skip(1) {
+        if k >= 2 {
+            // Sheared: the interface slips at its edges and sticks inside.
+            assert!(sa.slipping > 0 && sa.sticking > 0, "step {k}: {sa:?}");
+        }
+        assert!(sa.residual <= 1e-9, "step {k}: residual {}", sa.residual);
+        // The pair carries the applied 500 N × the step's factor, to 1e-6.
+        let load = 500.0 * sa.load_factor;
+        let [p, q] = &sa.contact_forces[..] else {
+            panic!("step {k}: {:?}", sa.contact_forces)
+        };
+        assert!(
+            (p.force[1].abs() - load).abs() <= 1e-6 * load,
+            "step {k}: {:?} against the load {load} N",
+            p.force
+        );
+        // Equal and opposite between the bodies, to 1e-9 of the load.
+        for (x, y) in p.force.iter().zip(&q.force) {
+            assert!((x + y).abs() <= 1e-9 * load, "step {k}: {x} against {y}");
+        }
+    }
+    // The coupled path (the exact law at every iterate) crosses the same steps to equilibria
+    // of the same kind, compared by their totals: friction's answer depends on the path (the
+    // coupled path cuts step 2; the counts of contacts differ by one or two), and the
+    // symmetric pair may break its symmetry opposite ways on the two paths.
+    world.contact.condense = false;
+    let mut sim = Simulation::new(&world).expect("builds");
+    for (k, (_, sa)) in condensed.iter().enumerate() {
+        let (_, sb) = sim.step(k).expect("solves");
+        for (pa, pb) in sa.contact_forces.iter().zip(&sb.contact_forces) {
+            assert!(
+                (pa.force[1] - pb.force[1]).abs() <= 1e-6 * pa.force[1].abs(),
+                "step {k}: {:?} against {:?}",
+                pa.force,
+                pb.force
+            );
+        }
+    }
+}

@@ -119,6 +119,12 @@ fn friction_of(
     if mu <= 0.0 {
         return None;
     }
+    // A contact held sticking within a Newton solve (see `FrictionHistory::held`).
+    let mu = if depth > 0.0 && history.held.contains(&key) {
+        Real::INFINITY
+    } else {
+        mu
+    };
     let mut dg = Vector3::zeros();
     for &(b, node, w) in nodes {
         let d = parts[b].dofs.dofs_per_node;

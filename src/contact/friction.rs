@@ -17,7 +17,7 @@
 
 use crate::Real;
 use nalgebra::{Matrix3, Vector3};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Coulomb friction of `[contact]`: the coefficient of every pair, and the pairs that differ.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -210,6 +210,11 @@ pub struct FrictionHistory {
     pub laws: Vec<Vec<(Real, Option<Real>)>>,
     /// Obstacles in the scene (where the bodies start in a row of `laws`).
     pub obstacles: usize,
+    /// Contacts held sticking whatever their tangential force (μ taken as infinite while they
+    /// press): only inside a Newton solve, on a copy of the history, to keep contacts whose
+    /// slip reversed between iterates from flipping back and forth. Such a solve ends only
+    /// when every held contact is within μ f_N, where the return mapping sticks anyway.
+    pub held: HashSet<FrictionKey>,
 }
 
 impl FrictionHistory {
@@ -226,6 +231,7 @@ impl FrictionHistory {
             offsets,
             laws,
             obstacles,
+            held: HashSet::new(),
         }
     }
 
@@ -248,6 +254,7 @@ impl FrictionHistory {
         self.committed.clear();
         self.u.iter_mut().flatten().for_each(|v| *v = 0.0);
         self.offsets.iter_mut().for_each(|o| *o = Vector3::zeros());
+        self.held.clear();
     }
 }
 

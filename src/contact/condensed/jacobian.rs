@@ -389,6 +389,26 @@ impl ContactJacobian {
         matches!(self.llt, Inverse::Friction(_))
     }
 
+    /// Whether `rows` are the Jacobian's contacts with friction, each sticking or slipping as
+    /// when the Jacobian last took their states (their stiffnesses may differ).
+    pub(crate) fn same_states(&self, rows: &[ContactRow]) -> bool {
+        self.has_friction()
+            && rows.len() == self.rows.len()
+            && self
+                .rows
+                .iter()
+                .zip(rows)
+                .all(|(old, new)| match (&old.friction, &new.friction) {
+                    (Some(a), Some(b)) => {
+                        a.first == b.first
+                            && a.count == b.count
+                            && a.slipping.is_some() == b.slipping.is_some()
+                    }
+                    (None, None) => true,
+                    _ => false,
+                })
+    }
+
     /// Take which contacts slip, and their stiffnesses, from `rows` (the same contacts at a
     /// later iterate) into a Jacobian with friction, keeping its `G C Gᵀ`, its factor and its
     /// rows' directions (a modified Newton step in `G`, exact in the friction law's state):

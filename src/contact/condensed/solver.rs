@@ -5,15 +5,18 @@ use crate::contact::condensed::{
     NOT_CANDIDATE,
 };
 use crate::contact::detect::widen;
+use crate::contact::evaluate::friction_key;
 use crate::contact::settle::{largest_nodal_move, BodyPart, Problem, STABILISATION};
-use crate::contact::{ActiveContact, ContactError, ContactSet, SlipState};
+use crate::contact::{
+    ActiveContact, ContactError, ContactSet, FrictionHistory, FrictionKey, SlipState,
+};
 use crate::linkage::body_state::norm;
 use crate::linkage::line_search::backtrack;
 use crate::linkage::{Body, Convergence, Mechanism, PhaseTimes};
 use crate::Real;
 use nalgebra::Vector3;
 use rayon::prelude::*;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
 /// A linear body's condensed state within the settle loop.
@@ -71,7 +74,52 @@ struct Residual {
     scale: Real,
     /// The contact rows at the placement.
     rows: Vec<ContactRow>,
+    /// The friction contacts at the placement (empty without friction).
+    friction: Vec<FrictionState>,
 }
+
+/// A friction contact's answer at one placement, for the holding of reversed contacts.
+struct FrictionState {
+    key: FrictionKey,
+    /// The direction of its tangential force (unit; zero without one).
+    direction: Vector3<Real>,
+    /// Whether it slips.
+    slipping: bool,
+    /// Whether it sticks with a tangential force beyond μ f_N (only a held contact can).
+    beyond: bool,
+}
+
+/// Newton with contacts held sticking (see [`FrictionHistory::held`]), against the flipping
+/// of contacts between sticking and slipping that stalls Newton at a shear's onset: a contact
+/// is held when Newton's full step turns its tangential force by more than a right angle and
+/// makes it slip, or when it turns from sticking to slipping a second time. (Holding every
+/// contact at a step's start, an elastic predictor, was tried and made more steps need a
+/// cut.) When Newton has converged so, the held contacts beyond μ f_N are let go (they slip)
+/// and Newton goes on. Converged only with every held contact
+/// within μ f_N, where the return mapping sticks too: the answer is that of the exact law.
+struct Holding {
+    /// The history the contacts are evaluated against, with the held contacts.
+    history: FrictionHistory,
+    /// How often each contact was held in this solve.
+    count: HashMap<FrictionKey, usize>,
+    /// How often held contacts were let go in this solve.
+    releases: usize,
+}
+
+/// Whether each contact not held slipped at the last iterate, and how often it has turned from
+/// sticking to slipping or back since it was last let go.
+#[derive(Default)]
+struct Flips {
+    slipped: HashMap<FrictionKey, bool>,
+    flips: HashMap<FrictionKey, usize>,
+}
+
+/// How often one contact may be held within a Newton solve.
+const MOST_HOLDS: usize = 2;
+
+/// How often held contacts may be let go within a Newton solve; beyond, every contact follows
+/// the exact law at every iterate.
+const MOST_RELEASES: usize = 8;
 
 /// The Newton of the contact problem on the bodies' contact candidates, every body linear and
 /// factored once per run (see [`CondensedBody`] and [`ContactJacobian`]).
@@ -299,8 +347,20 @@ impl CondensedSolver {
         let fc = &evaluated.forces;
         let mut missing = Vec::new();
         let mut rows = Vec::with_capacity(evaluated.list.len());
+        let mut friction = Vec::new();
         for e in &evaluated.list {
             let Some(n) = e.normal else { continue };
+            if let (Some(t), Some(h)) = (&e.tangential, p.friction) {
+                let (key, _) = friction_key(&e.contact);
+                let limit = h.law(&key).0 * e.normal_force().max(0.0);
+                let size = t.force.norm();
+                friction.push(FrictionState {
+                    key,
+                    direction: if size > 0.0 { t.force / size } else { t.force },
+                    slipping: t.state == SlipState::Slip,
+                    beyond: t.state == SlipState::Stick && size > limit,
+                });
+            }
             let row = |direction: &Vector3<Real>, missing: &mut Vec<(usize, usize)>| {
                 let mut entries = Vec::with_capacity(12);
                 for &(b, node, w) in &e.nodes {
@@ -404,6 +464,7 @@ impl CondensedSolver {
             norm: sum.sqrt(),
             scale,
             rows,
+            friction,
         })
     }
 
@@ -547,7 +608,8 @@ impl CondensedSolver {
                 .iter()
                 .map(|p| p.penalty.stiffness)
                 .fold(0.0, Real::max);
-        let mut monitor = Convergence::new(p.tolerance);
+        let tolerance = p.tolerance;
+        let mut monitor = Convergence::new(tolerance);
         let mut iterations = 0;
         let mut last_step = Real::INFINITY;
         let fresh = self.bodies.iter().all(|c| c.fresh);
@@ -555,7 +617,27 @@ impl CondensedSolver {
         let mut pending = None;
         // Slow iterations (see `FRICTION_SLOW_ITERATIONS`) with the kept friction Jacobian.
         let mut slow = 0;
+        let mut holding = p.friction.map(|h| Holding {
+            history: FrictionHistory {
+                held: HashSet::new(),
+                ..h.clone()
+            },
+            count: HashMap::new(),
+            releases: 0,
+        });
+        let mut flips = Flips::default();
+        // Iterations since the held contacts last changed (the law Newton solves changed).
+        let mut counted = 0;
         loop {
+            // The problem with the held contacts, as they are now.
+            let q = match &holding {
+                Some(h) => Problem {
+                    friction: Some(&h.history),
+                    ..*p
+                },
+                None => Problem { ..*p },
+            };
+            let p = &q;
             let t = Instant::now();
             let evaluated = match pending.take() {
                 Some(e) => Ok(e),
@@ -573,15 +655,69 @@ impl CondensedSolver {
                     return Ok(None);
                 }
             };
+            // With friction: contacts to hold from this iterate on (those that turned from
+            // sticking to slipping and back, then once more), and the iterate solved again
+            // with them held.
+            if let Some(h) = holding.as_ref() {
+                let hold = to_hold(h, &flips, &residual.friction);
+                if !hold.is_empty() {
+                    if let Some(h) = holding.as_mut() {
+                        for k in hold {
+                            h.history.held.insert(k);
+                            *h.count.entry(k).or_default() += 1;
+                            flips.slipped.remove(&k);
+                            flips.flips.remove(&k);
+                        }
+                    }
+                    monitor = Convergence::new(tolerance);
+                    counted = 0;
+                    last_step = Real::INFINITY;
+                    continue;
+                }
+            }
+            if let Some(h) = holding.as_ref() {
+                for f in residual.friction.iter() {
+                    if h.history.held.contains(&f.key) {
+                        continue;
+                    }
+                    if let Some(was) = flips.slipped.insert(f.key, f.slipping) {
+                        if was != f.slipping {
+                            *flips.flips.entry(f.key).or_default() += 1;
+                        }
+                    }
+                }
+            }
             let size = self.candidate_norm(parts);
             if p.converged(
                 &mut monitor,
                 residual.norm,
                 residual.scale,
-                iterations,
+                counted,
                 last_step,
                 size,
             )? {
+                let beyond: Vec<FrictionKey> = residual
+                    .friction
+                    .iter()
+                    .filter(|f| f.beyond)
+                    .map(|f| f.key)
+                    .collect();
+                if !beyond.is_empty() {
+                    // Converged with held contacts beyond μ f_N: they slip, Newton goes on.
+                    if let Some(h) = holding.as_mut() {
+                        h.releases += 1;
+                        if h.releases > MOST_RELEASES {
+                            h.history.held.clear();
+                        }
+                        for k in &beyond {
+                            h.history.held.remove(k);
+                        }
+                    }
+                    monitor = Convergence::new(tolerance);
+                    counted = 0;
+                    last_step = Real::INFINITY;
+                    continue;
+                }
                 if iterations == 0 && fresh {
                     // Nothing moved: the displacements are still those of the last solve.
                     self.bodies.iter_mut().for_each(|c| c.fresh = true);
@@ -606,7 +742,12 @@ impl CondensedSolver {
                 if !fast {
                     slow += 1;
                 }
-                reuse = slow < FRICTION_SLOW_ITERATIONS && j.restiffen(&views, &residual.rows);
+                // While Newton converges fast and no contact starts or stops slipping, the
+                // slipping contacts' stiffnesses are kept too (their Schur complement costs
+                // the cube of their rows).
+                reuse = slow < FRICTION_SLOW_ITERATIONS
+                    && ((fast && j.same_states(&residual.rows))
+                        || j.restiffen(&views, &residual.rows));
             }
             if !reuse {
                 slow = 0;
@@ -623,6 +764,7 @@ impl CondensedSolver {
                 .collect();
             times.solve += t.elapsed().as_secs_f64();
             iterations += 1;
+            counted += 1;
             if corr.stabilised {
                 if let Some(s) = p.capped(self.largest_move(parts, &corr)) {
                     self.apply(&base, &corr, s);
@@ -631,9 +773,41 @@ impl CondensedSolver {
                 }
             }
             let before = self.candidate_displacements(parts);
+            // With friction, Newton's full step is looked at first: contacts whose tangential
+            // force it turns back and makes slip are held sticking, and the iteration is made
+            // again from the same iterate with them held.
+            let mut full = None;
+            if holding.is_some() && !residual.friction.is_empty() {
+                self.apply(&base, &corr, 1.0);
+                let trial = self.residual(p, parts, normals).ok();
+                let reversed = match (&trial, &holding) {
+                    (Some(trial), Some(h)) => reversals(h, &residual.friction, &trial.friction),
+                    _ => Vec::new(),
+                };
+                if !reversed.is_empty() {
+                    if let Some(h) = holding.as_mut() {
+                        for k in reversed {
+                            h.history.held.insert(k);
+                            *h.count.entry(k).or_default() += 1;
+                        }
+                    }
+                    self.apply(&base, &corr, 0.0);
+                    monitor = Convergence::new(tolerance);
+                    counted = 0;
+                    last_step = Real::INFINITY;
+                    continue;
+                }
+                full = trial;
+            }
             // The residual of the accepted trial is the next iteration's: kept, not recomputed.
             let mut last = None;
             let (s, accepted) = backtrack(residual.norm, |s| {
+                if s == 1.0 {
+                    if let Some(e) = full.take() {
+                        last = Some(e);
+                        return last.as_ref().map_or(Real::INFINITY, |e| e.norm);
+                    }
+                }
                 self.apply(&base, &corr, s);
                 last = self.residual(p, parts, normals).ok();
                 last.as_ref().map_or(Real::INFINITY, |e| e.norm)
@@ -666,6 +840,49 @@ impl CondensedSolver {
         self.expand(parts, times);
         None
     }
+}
+
+/// Contacts flipping between sticking and slipping this often are held sticking.
+const FLIPS_TO_HOLD: usize = 3;
+
+/// The contacts of the iterate `at` to hold sticking: those not held that slip again after
+/// [`FLIPS_TO_HOLD`] − 1 turns between sticking and slipping, each held fewer than
+/// [`MOST_HOLDS`] times.
+fn to_hold(h: &Holding, flips: &Flips, at: &[FrictionState]) -> Vec<FrictionKey> {
+    if h.releases > MOST_RELEASES {
+        return Vec::new();
+    }
+    at.iter()
+        .filter(|f| {
+            !h.history.held.contains(&f.key)
+                && h.count.get(&f.key).copied().unwrap_or(0) < MOST_HOLDS
+                && f.slipping
+                && flips.slipped.get(&f.key) == Some(&false)
+                && flips.flips.get(&f.key).copied().unwrap_or(0) + 1 >= FLIPS_TO_HOLD
+        })
+        .map(|f| f.key)
+        .collect()
+}
+
+/// The contacts of `trial` (Newton's full step from the iterate of `at`) to hold sticking:
+/// not held yet, held fewer than [`MOST_HOLDS`] times, slipping at the trial with their
+/// tangential force turned by more than a right angle from the iterate's.
+fn reversals(h: &Holding, at: &[FrictionState], trial: &[FrictionState]) -> Vec<FrictionKey> {
+    let before: HashMap<FrictionKey, &Vector3<Real>> =
+        at.iter().map(|f| (f.key, &f.direction)).collect();
+    trial
+        .iter()
+        .filter(|f| {
+            f.slipping
+                && h.releases <= MOST_RELEASES
+                && !h.history.held.contains(&f.key)
+                && h.count.get(&f.key).copied().unwrap_or(0) < MOST_HOLDS
+                && before
+                    .get(&f.key)
+                    .is_some_and(|d| d.dot(&f.direction) < 0.0)
+        })
+        .map(|f| f.key)
+        .collect()
 }
 
 /// Slow iterations (a residual not below a tenth of the one before) a Jacobian with friction
