@@ -344,3 +344,175 @@ pub(crate) fn bench_prepare() -> Result<()> {
     );
     Ok(())
 }
+
+/// `linkage bench --cholmod`: ordering + factorization + solve of each lattice's `K_ff` by
+/// our direct solver and by CHOLMOD (scikit-sparse, run by `python`), alternately `reps`
+/// times on the same matrix; prints every repetition, the best of each and their ratio.
+pub(crate) fn bench_cholmod(
+    cells: Vec<[usize; 3]>,
+    reps: usize,
+    python: Option<PathBuf>,
+) -> Result<()> {
+    let python = python
+        .or_else(|| std::env::var_os("LINKAGE_CHOLMOD_PYTHON").map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from("python3"));
+    let python = python.as_path();
+    use linkage::bench::cholmod::{
+        lattice_system, load_average, system_npz, time_direct, COMPARE_SCRIPT,
+    };
+    let sizes = if cells.is_empty() {
+        vec![[20, 20, 40], [40, 40, 40]]
+    } else {
+        cells
+    };
+    let reps = reps.max(1);
+    let dir = tempfile_dir("linkage-cholmod")?;
+    let outcome = (|| -> Result<()> {
+        let script = dir.join("cholmod_compare.py");
+        linkage::scene::atomic_file::write_atomically(&script, COMPARE_SCRIPT.as_bytes())
+            .with_context(|| format!("writing {}", script.display()))?;
+        let load = |l: Option<f64>| l.map_or("?".to_string(), |l| format!("{l:.2}"));
+        println!(
+            "Direct solve of the same K_ff: ours (METIS on the node graph, faer, {} threads) \
+             against CHOLMOD (scikit-sparse, METIS, supernodal), alternately, best of {reps}",
+            rayon::current_num_threads()
+        );
+        println!("load average at start: {}", load(load_average()));
+        println!(
+            "{:<10} {:>3} {:>9} | {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} | {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} | {:>6} {:>5}",
+            "cells", "rep", "free DOFs",
+            "analyze", "factor", "solve", "total", "CPU", "resid",
+            "analyze", "factor", "solve", "total", "CPU", "resid",
+            "ratio", "load"
+        );
+        for c in sizes {
+            let (system, _members) = lattice_system(c).map_err(anyhow::Error::msg)?;
+            let file = dir.join(format!("system-{}x{}x{}.npz", c[0], c[1], c[2]));
+            let bytes = system_npz(&system).context("encoding the system")?;
+            linkage::scene::atomic_file::write_atomically(&file, &bytes)
+                .with_context(|| format!("writing {}", file.display()))?;
+            drop(bytes);
+            let name = format!("{}x{}x{}", c[0], c[1], c[2]);
+            let mut ours_best: Option<linkage::bench::cholmod::DirectTiming> = None;
+            let mut theirs_best: Option<CholmodTiming> = None;
+            let mut plain_best: Option<linkage::bench::cholmod::DirectTiming> = None;
+            let mut fills = (0, None);
+            for rep in 1..=reps {
+                let ours =
+                    time_direct(&system, Default::default(), true).map_err(anyhow::Error::msg)?;
+                let theirs = run_cholmod(python, &script, &file, rep == 1)?;
+                let plain =
+                    time_direct(&system, Default::default(), false).map_err(anyhow::Error::msg)?;
+                if rep == 1 {
+                    fills = (ours.nnz_l, theirs.nnz_l);
+                }
+                println!(
+                    "{:<10} {:>3} {:>9} | {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>6.2}s {:>8.1e} | {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>6.2}s {:>8.1e} | {:>6.3} {:>5}",
+                    name, rep, system.n,
+                    ours.analyze, ours.factor, ours.solve, ours.total(), ours.cpu, ours.residual,
+                    theirs.analyze, theirs.factor, theirs.solve, theirs.total(), theirs.cpu, theirs.residual,
+                    ours.total() / theirs.total(),
+                    load(load_average())
+                );
+                println!(
+                    "{:<10} {:>3} {:>9} | {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>6.2}s {:>8.1e} | faer's own supernode loop: {:.3} of CHOLMOD",
+                    "", "", "",
+                    plain.analyze, plain.factor, plain.solve, plain.total(), plain.cpu, plain.residual,
+                    plain.total() / theirs.total(),
+                );
+                if ours.residual.max(plain.residual) > 1e-10 || theirs.residual > 1e-10 {
+                    bail!(
+                        "{name}: residual too large (ours {:.1e}, CHOLMOD {:.1e})",
+                        ours.residual,
+                        theirs.residual
+                    );
+                }
+                if plain_best.is_none_or(|b| plain.total() < b.total()) {
+                    plain_best = Some(plain);
+                }
+                if ours_best.is_none_or(|b| ours.total() < b.total()) {
+                    ours_best = Some(ours);
+                }
+                if theirs_best
+                    .as_ref()
+                    .is_none_or(|b| theirs.total() < b.total())
+                {
+                    theirs_best = Some(theirs);
+                }
+            }
+            if let (Some(p), Some(t)) = (plain_best, theirs_best.as_ref()) {
+                println!(
+                    "{name}: best with faer's own supernode loop {:.3} s (analyze {:.3} + factor {:.3} + solve {:.3}): ratio {:.3}",
+                    p.total(), p.analyze, p.factor, p.solve, p.total() / t.total()
+                );
+            }
+            if let (Some(o), Some(t)) = (ours_best, theirs_best) {
+                println!(
+                    "{name}: best ours {:.3} s (analyze {:.3} + factor {:.3} + solve {:.3}), \
+                     best CHOLMOD {:.3} s (analyze {:.3} + factor {:.3} + solve {:.3}): \
+                     ratio {:.3}; factor+solve alone {:.3}; nnz(L) ours {} CHOLMOD {}",
+                    o.total(),
+                    o.analyze,
+                    o.factor,
+                    o.solve,
+                    t.total(),
+                    t.analyze,
+                    t.factor,
+                    t.solve,
+                    o.total() / t.total(),
+                    (o.factor + o.solve) / (t.factor + t.solve),
+                    fills.0,
+                    fills.1.map_or("?".to_string(), |n| n.to_string()),
+                );
+            }
+        }
+        println!("load average at end: {}", load(load_average()));
+        Ok(())
+    })();
+    let _ = std::fs::remove_dir_all(&dir);
+    outcome
+}
+
+/// CHOLMOD's phases as `bench/cholmod_compare.py` reports them.
+#[derive(serde::Deserialize)]
+struct CholmodTiming {
+    analyze: f64,
+    factor: f64,
+    solve: f64,
+    cpu: f64,
+    residual: f64,
+    nnz_l: Option<usize>,
+}
+
+impl CholmodTiming {
+    fn total(&self) -> f64 {
+        self.analyze + self.factor + self.solve
+    }
+}
+
+/// Runs the comparison script on one system file and reads its JSON line.
+fn run_cholmod(python: &Path, script: &Path, file: &Path, fill: bool) -> Result<CholmodTiming> {
+    let mut command = std::process::Command::new(python);
+    command.arg(script).arg(file);
+    if fill {
+        command.arg("fill");
+    }
+    let output = command.output().with_context(|| {
+        format!(
+            "cannot start {} (pass a Python with scikit-sparse by --python or \
+             LINKAGE_CHOLMOD_PYTHON; docs/PERFORMANCE.md says how to install it)",
+            python.display()
+        )
+    })?;
+    if !output.status.success() {
+        bail!(
+            "the CHOLMOD comparison failed ({}): {}",
+            output.status,
+            String::from_utf8_lossy(&output.stderr).trim()
+        );
+    }
+    let text = String::from_utf8_lossy(&output.stdout);
+    let line = text.lines().last().unwrap_or_default();
+    serde_json::from_str(line)
+        .with_context(|| format!("cannot read the CHOLMOD script's output {line:?}"))
+}

@@ -5,8 +5,8 @@ mod bench_cli;
 
 use anyhow::{bail, Context, Result};
 use bench_cli::{
-    bench, bench_contact, bench_fracture, bench_gif, bench_large, bench_prepare, bench_read,
-    bench_render, bench_run,
+    bench, bench_cholmod, bench_contact, bench_fracture, bench_gif, bench_large, bench_prepare,
+    bench_read, bench_render, bench_run,
 };
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -176,6 +176,18 @@ enum Command {
         /// With --fracture: members to break (default 1000).
         #[arg(long, requires = "fracture")]
         breaks: Option<usize>,
+        /// The direct solver against CHOLMOD instead: each lattice's K_ff (default 20x20x40 and
+        /// 40x40x40 cells) ordered, factored and solved by ours and by CHOLMOD (scikit-sparse,
+        /// METIS) alternately on the same matrix; prints both and the ratio.
+        #[arg(long)]
+        cholmod: bool,
+        /// With --cholmod: repetitions of each side (the best counts).
+        #[arg(long, requires = "cholmod", default_value_t = 3)]
+        reps: usize,
+        /// With --cholmod: the Python with numpy, scipy and scikit-sparse (default: the
+        /// environment variable LINKAGE_CHOLMOD_PYTHON, else python3).
+        #[arg(long, requires = "cholmod")]
+        python: Option<PathBuf>,
         /// Time drawing one frame of a shaded shell instead (see --patches, --size).
         #[arg(long)]
         render: bool,
@@ -339,6 +351,13 @@ fn main() -> ExitCode {
             run: true, cells, ..
         } => bench_run(cells),
         Command::Bench { prepare: true, .. } => bench_prepare(),
+        Command::Bench {
+            cholmod: true,
+            cells,
+            reps,
+            python,
+            ..
+        } => bench_cholmod(cells, reps, python),
         Command::Bench {
             render: true,
             patches,

@@ -38,7 +38,7 @@ mod instability;
 mod link_lines;
 mod mesh_file;
 mod model_file;
-mod npz_archive;
+pub(crate) mod npz_archive;
 mod npz_files;
 mod obstacles;
 pub mod paper_files;
