@@ -19,4 +19,3 @@ mod low_rank;
 pub mod multigrid;
 pub mod ordering;
 mod symmetric_csr;
-mod tree_cholesky;
