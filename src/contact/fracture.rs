@@ -14,8 +14,9 @@
 //! already beyond its strength just after a break breaks at that break's load (a snap-back
 //! below it is not followed, unlike [`BreakingEquilibrium`](crate::linkage::fracture::BreakingEquilibrium)).
 //!
-//! A broken member keeps its place in the body with a copy of its material of zero modulus (a
-//! softened one: of its tooth's modulus), so numbering, patterns and surfaces stay. Contact
+//! A broken member keeps its place in the body with a modulus factor of zero (a softened one:
+//! its tooth's, [`Body::member_factors`]), so numbering, patterns, surfaces and the materials
+//! stay. Contact
 //! is solved on the coupled path for a scene with breaking bodies: the condensed path factors
 //! each body once per run, and a break changes its compliance. A break after which contact
 //! cannot be settled (a piece no support or contact holds, or the structure a mechanism) is the
@@ -75,7 +76,7 @@ impl From<ContactError> for FractureStop {
 
 /// The bodies of a contact scene as they break, and each breaking body's members.
 pub struct ContactFracture {
-    /// The bodies as they are now (broken members of zero modulus).
+    /// The bodies as they are now (broken members of modulus factor zero).
     pub bodies: Vec<Body>,
     original: Vec<Body>,
     breaking: Vec<Option<Breaking>>,
@@ -195,13 +196,10 @@ impl ContactFracture {
     }
 
     /// Break member `m` of body `b`, or move it to its next tooth (returned, 1-based: the
-    /// tooth passed).
+    /// tooth passed). The body's member factor follows (its materials stay the scene's).
     fn break_member(&mut self, b: usize, m: usize) -> Option<usize> {
         let br = self.breaking[b].as_mut()?;
         let next = br.tooth[m] + 1;
-        let body = &mut self.bodies[b];
-        let material = self.original[b].members[m].material;
-        let mut copy = self.original[b].materials[material].clone();
         let passed = match br.teeth[m].get(next).copied() {
             Some(t) => {
                 br.tooth[m] = next;
@@ -219,10 +217,11 @@ impl ContactFracture {
                 None
             }
         };
-        copy.youngs_modulus *= br.factor[m];
-        copy.name = format!("{} (member {})", copy.name, m + 1);
-        body.materials.push(copy);
-        body.members[m].material = body.materials.len() - 1;
+        let body = &mut self.bodies[b];
+        if body.member_factors.len() != body.members.len() {
+            body.member_factors = vec![1.0; body.members.len()];
+        }
+        body.member_factors[m] = br.factor[m];
         passed
     }
 

@@ -109,6 +109,10 @@ pub struct Body {
     pub patches: Vec<[usize; 3]>,
     /// Materials referred to by the members.
     pub materials: Vec<Material>,
+    /// Per member its Young's modulus as a fraction of its material's, in [0, 1]: below 1 for
+    /// a member softened by a tooth, 0 for a broken one (fracture keeps the materials as the
+    /// scene wrote them). Empty: 1 for every member.
+    pub member_factors: Vec<Real>,
     /// Supports; a node may appear in several (their fixed directions combine).
     pub supports: Vec<Support>,
     /// Applied nodal forces.
@@ -305,6 +309,17 @@ impl Body {
             materials: vec![material],
             ..Default::default()
         }
+    }
+
+    /// Member `m`'s Young's modulus as a fraction of its material's (see
+    /// [`Body::member_factors`]).
+    pub fn modulus_factor(&self, m: usize) -> Real {
+        self.member_factors.get(m).copied().unwrap_or(1.0)
+    }
+
+    /// Member `m`'s Young's modulus, Pa: its material's times its factor.
+    pub fn member_modulus(&self, m: usize) -> Real {
+        self.materials[self.members[m].material].youngs_modulus * self.modulus_factor(m)
     }
 
     /// Number of degrees of freedom: nodes × (2 or 3).

@@ -8,7 +8,8 @@
 //! by node: see [`crate::linkage::DofMap`]), m; forces likewise, N.
 
 use crate::linkage::{
-    member_response, prescribed_displacements, Body, MemberResponse, Schedule, StiffnessAssembly,
+    prescribed_displacements, scaled_member_response, Body, MemberResponse, Schedule,
+    StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
@@ -23,14 +24,16 @@ pub fn node_vector(u: &[Real], d: usize, node: usize) -> Vector3<Real> {
 }
 
 /// The response of member `m` at the displacement `u` (per body DOF), for the body's
-/// kinematics and the member's material (paper Eq. 1 for linear kinematics).
+/// kinematics and the member's material and modulus factor (paper Eq. 1 for linear
+/// kinematics).
 pub fn member_response_at(body: &Body, u: &[Real], m: usize) -> MemberResponse {
     let d = body.dimension.dofs_per_node();
     let member = body.members[m];
     let [a, b] = member.nodes;
-    member_response(
+    scaled_member_response(
         body.kinematics,
         &body.materials[member.material],
+        body.modulus_factor(m),
         &body.nodes[a],
         &body.nodes[b],
         &node_vector(u, d, a),

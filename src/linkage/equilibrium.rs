@@ -372,7 +372,7 @@ impl Equilibrium {
             let stretch = linear_stretch(&u, d, [a, b], &n);
             let strain = stretch / body.member_length(m);
             let material = &body.materials[member.material];
-            (strain, material.youngs_modulus * strain * material.area)
+            (strain, body.member_modulus(m) * strain * material.area)
         });
         let mut state = post_process(body, &self.dofs, &u, &forces, &internal, members);
         state.iterations = usize::from(step > 0);

@@ -39,10 +39,24 @@ pub fn member_response(
     ua: &Vector3<Real>,
     ub: &Vector3<Real>,
 ) -> MemberResponse {
+    scaled_member_response(kinematics, material, 1.0, a0, b0, ua, ub)
+}
+
+/// [`member_response`] of a member whose Young's modulus is `modulus_factor` times its
+/// material's (a softened or broken member: see [`crate::linkage::Body::member_factors`]).
+pub fn scaled_member_response(
+    kinematics: Kinematics,
+    material: &Material,
+    modulus_factor: Real,
+    a0: &Vector3<Real>,
+    b0: &Vector3<Real>,
+    ua: &Vector3<Real>,
+    ub: &Vector3<Real>,
+) -> MemberResponse {
     let d0 = b0 - a0;
     let rest = d0.norm();
     let n0 = d0 / rest;
-    let ea = material.youngs_modulus * material.area;
+    let ea = material.youngs_modulus * modulus_factor * material.area;
     let k = ea / rest;
     let (strain, axis, length) = match kinematics {
         Kinematics::Linear => (n0.dot(&(ub - ua)) / rest, n0, rest),
@@ -143,5 +157,23 @@ mod tests {
         );
         assert_eq!(slack.force, 0.0);
         assert!(slack.strain < 0.0);
+    }
+
+    /// A modulus factor is the member of a material with the scaled modulus, to the bit (so
+    /// fracture's factors reproduce its former copies of the material).
+    #[test]
+    fn a_modulus_factor_is_a_material_of_scaled_modulus() {
+        let m = Material::new("m", 30e9, 2e-3);
+        let (a0, b0) = (v(0.0, 0.0, 0.0), v(0.3, 0.1, -0.2));
+        let (ua, ub) = (v(1e-4, -2e-4, 0.0), v(-3e-4, 5e-5, 2e-4));
+        for kinematics in [Kinematics::Linear, Kinematics::Large] {
+            for f in [0.0, 0.37, 1.0] {
+                let mut scaled = m.clone();
+                scaled.youngs_modulus *= f;
+                let copy = member_response(kinematics, &scaled, &a0, &b0, &ua, &ub);
+                let factor = scaled_member_response(kinematics, &m, f, &a0, &b0, &ua, &ub);
+                assert_eq!(copy, factor, "{kinematics:?} {f}");
+            }
+        }
     }
 }

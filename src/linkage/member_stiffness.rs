@@ -9,14 +9,13 @@ pub fn axial_stiffness(material: &Material, length: Real) -> Real {
     material.area * material.youngs_modulus / length
 }
 
-/// The axial stiffness `A E / L` of every member of `body`, in member order, N/m.
+/// The axial stiffness `A E / L` of every member of `body`, in member order, N/m (`E` its
+/// material's times its factor, [`Body::member_modulus`]).
 pub fn member_stiffnesses(body: &Body) -> Vec<Real> {
     (0..body.members.len())
         .map(|m| {
-            axial_stiffness(
-                &body.materials[body.members[m].material],
-                body.member_length(m),
-            )
+            body.materials[body.members[m].material].area * body.member_modulus(m)
+                / body.member_length(m)
         })
         .collect()
 }

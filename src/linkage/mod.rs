@@ -16,7 +16,7 @@ pub use self::kinematics::{Kinematics, NewtonSettings, PathMethod};
 pub use self::material::{Behaviour, Failure, Material, Scatter, Softening};
 pub use self::mechanism::Mechanism;
 pub use self::member_check::check_members;
-pub use self::member_response::{member_response, MemberResponse};
+pub use self::member_response::{member_response, scaled_member_response, MemberResponse};
 pub use self::member_stiffness::{
     axial_stiffness, member_block, member_stiffness_matrix, member_stiffnesses,
 };

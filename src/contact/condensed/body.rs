@@ -397,7 +397,7 @@ fn linear_block(body: &Body, m: usize) -> nalgebra::Matrix3<Real> {
     member_block(
         &body.nodes[a],
         &body.nodes[b],
-        material.youngs_modulus * material.area / body.member_length(m),
+        body.member_modulus(m) * material.area / body.member_length(m),
     )
 }
 
