@@ -689,3 +689,47 @@ displacement = [1e-4, 0.0]
     );
     assert!(text.contains("fracture_energy = 14 J/m²"), "{text}");
 }
+
+/// The bundled softening variant of paper_fracture: until its first event the solid is the
+/// brittle one, so its first tooth is passed at paper_fracture's first break (same member, load
+/// factor to 1e-12); every member then passes its teeth 1, 2, 3 in order before it breaks, and
+/// the solid collapses in step 3 as the brittle one does, by breaking member 77.
+#[test]
+fn the_softening_variant_of_paper_fracture_passes_its_teeth_then_collapses() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let out = tempfile::tempdir().unwrap();
+    let brittle = run(
+        &load_scene(&root.join("paper_fracture.toml")).unwrap(),
+        out.path(),
+        &|| {},
+    )
+    .unwrap();
+    let soft = run(
+        &load_scene(&root.join("paper_fracture_softening.toml")).unwrap(),
+        out.path(),
+        &|| {},
+    )
+    .unwrap();
+    let (first, b) = (&soft.breaks[0], &brittle.breaks[0]);
+    assert_eq!(
+        (first.step, first.member, first.tooth),
+        (b.step, b.member, Some(1))
+    );
+    assert!(close(first.load_factor, b.load_factor, 1e-12));
+    for member in [1, 77] {
+        let teeth: Vec<Option<usize>> = soft
+            .breaks
+            .iter()
+            .filter(|e| e.member == member)
+            .map(|e| e.tooth)
+            .collect();
+        assert_eq!(
+            teeth,
+            vec![Some(1), Some(2), Some(3), None],
+            "member {member}"
+        );
+    }
+    assert_eq!(soft.breaks.len(), 8);
+    let collapse = soft.collapse.as_ref().expect("a collapse");
+    assert_eq!((collapse.step, collapse.member), (3, 77));
+}
