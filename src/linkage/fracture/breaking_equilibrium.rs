@@ -36,7 +36,10 @@ use std::time::Instant;
 
 /// Breaks between refactorizations of `K_ff` by default: the Woodbury correction of a solve
 /// costs `O(n r)` on top of the triangular solves, so `r` is kept well below the factor's fill.
-pub const DEFAULT_REFACTOR_EVERY: usize = 64;
+/// On the 108,860-member benchmark lattice a correction at r = 128 still costs a few percent
+/// of a solve, while a refactorization costs 16–23 solves: 128 halves the refactorizations of
+/// 64 for little more per break (see docs/PERFORMANCE.md, "Fracture").
+pub const DEFAULT_REFACTOR_EVERY: usize = 128;
 
 /// A break whose `1 − k gᵀ K⁻¹ g` is at most this leaves `K_ff` singular: a piece falls off
 /// or the structure collapses. Not far below 1: a part left on a hinge is singular only up to
