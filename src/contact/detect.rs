@@ -444,10 +444,7 @@ impl Geometry {
                         consider(Target::Patch { body: other, patch }, depth);
                     }
                 }
-                if let Some((target, depth)) =
-                    self.own
-                        .deepest(&own, bodies, parts, (b, node), &x, min_depth)
-                {
+                if let Some((target, depth)) = self.own.deepest(&own, (b, node), &x, min_depth) {
                     consider(target, depth);
                 }
                 if let Some((with, _)) = deepest {

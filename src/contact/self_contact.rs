@@ -23,9 +23,9 @@
 //!
 //! **Crack faces.** A member broken in tension (its ends apart at the break) is a crack's
 //! bridge: when its ends come back closer than its rest length `L₀`, the crack has closed, and
-//! its two end nodes press on each other along the line between them with the depth
-//! `L₀ − |xⱼ − xᵢ|` and the body's penalty (a compression-only spring of the penalty's
-//! stiffness). A crack then closes exactly to where its faces were at rest, not a member's
+//! its two end nodes press on each other along the member's undeformed axis `e₀` with the depth
+//! `−e₀ · (uⱼ − uᵢ)` (the member's shortening; breaking bodies have linear kinematics) and the
+//! body's penalty: a compression-only spring of the penalty's stiffness. A crack then closes exactly to where its faces were at rest, not a member's
 //! length further as a surface rebuilt along the crack faces would allow (the faces of a
 //! lattice crack lie one broken member apart). A member broken in compression (crushed) does
 //! not close. Limits: crack faces that slide along each other by more than about a member
@@ -36,6 +36,7 @@ use crate::contact::boundary::{segment_projection, Surface};
 use crate::contact::patch_surface::PatchSurface;
 use crate::contact::settle::{position, BodyPart};
 use crate::contact::{penetration_tolerance, ActiveContact, ContactSet, Penalty, Target};
+use crate::linkage::body_state::{linear_stretch, undeformed_axis};
 use crate::linkage::fracture::breaks_members;
 use crate::linkage::{member_stiffnesses, Body};
 use crate::Real;
@@ -48,7 +49,7 @@ pub const SELF_RINGS: usize = 2;
 
 /// A node is held by a segment of its own body at most this many mean member lengths behind
 /// it (deeper, it went round the segment's end, not through it).
-pub const SELF_REACH_MEMBERS: Real = 3.0;
+pub const SELF_REACH_MEMBERS: Real = 1.5;
 
 /// A foot this far (a fraction of the segment or patch) beyond its end or edge still lies on
 /// it: round-off does not let a node slip between two segments, or past the corner it meets in
@@ -90,12 +91,16 @@ pub(crate) struct SelfGrid {
     cells: Vec<Option<Grid>>,
 }
 
-/// Targets of one body by grid cell (cell side = its reach).
+/// Targets of one body by grid cell (cell side: twice its reach).
 struct Grid {
     side: Real,
     cells: HashMap<[i64; 3], Vec<usize>>,
     /// Corner nodes of every target.
     corners: Vec<Vec<usize>>,
+    /// The body's deformed node positions, m.
+    now: Vec<Vector3<Real>>,
+    /// Per target, its bounding box widened by the reach, m.
+    boxes: Vec<[Vector3<Real>; 2]>,
 }
 
 impl Grid {
@@ -190,9 +195,7 @@ impl SelfContact {
                 if *k > 0.0 {
                     own.broken[m] = None;
                 } else if own.broken[m].is_none() {
-                    let [i, j] = bodies[b].members[m].nodes;
-                    let length = (own.start[j] - own.start[i]).norm();
-                    own.broken[m] = Some(length >= bodies[b].member_length(m));
+                    own.broken[m] = Some(closure(bodies, parts, b, m).is_some_and(|d| d <= 0.0));
                 }
             }
         }
@@ -216,9 +219,13 @@ impl SelfContact {
                     .filter(|o| !o.start.is_empty() && o.reach > 0.0)?;
                 let corners = targets(b, surfaces, patch_surfaces)?;
                 let mut grid = Grid {
-                    side: own.reach,
+                    side: 2.0 * own.reach,
                     cells: HashMap::new(),
                     corners: Vec::new(),
+                    boxes: Vec::with_capacity(corners.len()),
+                    now: (0..bodies[b].nodes.len())
+                        .map(|n| position(bodies, parts, b, n))
+                        .collect(),
                 };
                 for (t, nodes) in corners.iter().enumerate() {
                     let (mut lo, mut hi) = (
@@ -226,14 +233,15 @@ impl SelfContact {
                         Vector3::repeat(-Real::INFINITY),
                     );
                     for &n in nodes {
-                        let x = position(bodies, parts, b, n);
-                        lo = lo.inf(&x);
-                        hi = hi.sup(&x);
+                        lo = lo.inf(&grid.now[n]);
+                        hi = hi.sup(&grid.now[n]);
                     }
                     let (lo, hi) = (
-                        grid.cell(&(lo - Vector3::repeat(own.reach))),
-                        grid.cell(&(hi + Vector3::repeat(own.reach))),
+                        lo - Vector3::repeat(own.reach),
+                        hi + Vector3::repeat(own.reach),
                     );
+                    grid.boxes.push([lo, hi]);
+                    let (lo, hi) = (grid.cell(&lo), grid.cell(&hi));
                     for i in lo[0]..=hi[0] {
                         for j in lo[1]..=hi[1] {
                             for k in lo[2]..=hi[2] {
@@ -255,8 +263,6 @@ impl SelfContact {
     pub(crate) fn deepest(
         &self,
         grid: &SelfGrid,
-        bodies: &[Body],
-        parts: &[BodyPart],
         (b, node): (usize, usize),
         x: &Vector3<Real>,
         min_depth: Real,
@@ -268,6 +274,10 @@ impl SelfContact {
         let corners = &grid.corners;
         let mut best: Option<(Target, Real)> = None;
         for &t in list {
+            let [lo, hi] = &grid.boxes[t];
+            if (0..3).any(|k| x[k] < lo[k] || x[k] > hi[k]) {
+                continue;
+            }
             let nodes = &corners[t];
             if nodes.iter().any(|n| near.binary_search(n).is_ok()) {
                 continue;
@@ -280,10 +290,7 @@ impl SelfContact {
             } else {
                 Target::Patch { body: b, patch: t }
             };
-            let now: Vec<Vector3<Real>> = nodes
-                .iter()
-                .map(|&n| position(bodies, parts, b, n))
-                .collect();
+            let now: Vec<Vector3<Real>> = nodes.iter().map(|&n| grid.now[n]).collect();
             let Some((depth, on)) = behind(x, &now) else {
                 continue;
             };
@@ -320,9 +327,8 @@ impl SelfContact {
                 if *broken != Some(true) {
                     continue;
                 }
-                let [i, j] = bodies[b].members[m].nodes;
-                let length = (position(bodies, parts, b, j) - position(bodies, parts, b, i)).norm();
-                if bodies[b].member_length(m) - length > min_depth {
+                let i = bodies[b].members[m].nodes[0];
+                if closure(bodies, parts, b, m).is_some_and(|d| d > min_depth) {
                     out.push(ActiveContact {
                         body: b,
                         node: i,
@@ -405,21 +411,37 @@ pub(crate) type Closed = (
     Penalty,
 );
 
-/// The depth (m), normal (from the other end towards `i`) and penalty of a closed crack: member
-/// `member` of `body`, its ends `i` (pressing) and `j`, at the current displacements.
+/// How far the ends `i → j` of member `member` of `body` have closed beyond its rest length,
+/// m: `−e₀ · (uⱼ − uᵢ)` along its undeformed axis `e₀` (linear kinematics, as the breaking
+/// bodies are: the closure is then a compression-only spring of the penalty's stiffness along
+/// the member, linear in the displacements, and its tangent `k e₀ e₀ᵀ` is exact).
+fn closure(bodies: &[Body], parts: &[BodyPart], body: usize, member: usize) -> Option<Real> {
+    let b = bodies.get(body)?;
+    let nodes = b.members.get(member)?.nodes;
+    let axis = undeformed_axis(b, nodes[0], nodes[1]);
+    let part = &parts[body];
+    Some(-linear_stretch(
+        &part.u,
+        part.dofs.dofs_per_node,
+        nodes,
+        &axis,
+    ))
+}
+
+/// The depth (m, see [`closure`]), normal (`−e₀`: from the other end towards the pressing
+/// one), nodes and penalty of the closed crack of member `member` of `body`.
 pub(crate) fn closing(
     bodies: &[Body],
     parts: &[BodyPart],
     body: usize,
     member: usize,
 ) -> Option<Closed> {
-    let [i, j] = bodies.get(body)?.members.get(member)?.nodes;
-    let d = position(bodies, parts, body, i) - position(bodies, parts, body, j);
-    let length = d.norm();
-    let normal = (length > 0.0).then(|| d / length);
+    let depth = closure(bodies, parts, body, member)?;
+    let [i, j] = bodies[body].members[member].nodes;
+    let axis = undeformed_axis(&bodies[body], i, j);
     Some((
-        bodies[body].member_length(member) - length,
-        normal,
+        depth,
+        Some(-axis),
         vec![(body, i, 1.0), (body, j, -1.0)],
         parts[body].penalty,
     ))
