@@ -52,6 +52,14 @@ pub enum Target {
         /// The patch (3D) or boundary segment (2D) of the body pressed.
         patch: usize,
     },
+    /// The other end of a broken member of the node's own body whose crack has closed (its
+    /// ends closer than its rest length): the crack's faces press on each other there.
+    Closing {
+        /// The body (index in the scene).
+        body: usize,
+        /// The broken member (index in the body's members); the node is its first end.
+        member: usize,
+    },
 }
 
 /// The active contacts, sorted: two sets compare equal when the same nodes touch the same

@@ -4,6 +4,7 @@ use crate::contact::boundary::{inside_polygon, segment_projection, Surface};
 use crate::contact::obstacle_features::Features;
 use crate::contact::obstacles::to_glam;
 use crate::contact::patch_surface::PatchSurface;
+use crate::contact::self_contact::SelfContact;
 use crate::contact::settle::{position, BodyPart};
 use crate::contact::{
     penetration_tolerance, ActiveContact, ContactError, ContactSet, Obstacle, Obstacles,
@@ -66,6 +67,8 @@ pub(crate) struct Geometry {
     pub(crate) shell_reach: Vec<Real>,
     /// The rigid obstacles, held in rapier.
     pub(crate) obstacles: Obstacles,
+    /// Contact of the bodies with themselves.
+    pub(crate) own: SelfContact,
     /// Their sharp features and the crossings of nodes into them.
     pub(crate) features: Features,
 }
@@ -73,7 +76,11 @@ pub(crate) struct Geometry {
 impl Geometry {
     /// The surfaces of `bodies` (an open shell is a two-sided target: see
     /// [`Geometry::record_sides`]) and the colliders of `obstacles`.
-    pub(crate) fn new(bodies: &[Body], obstacles: &[Obstacle]) -> Result<Self, ContactError> {
+    pub(crate) fn new(
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        self_contact: Option<bool>,
+    ) -> Result<Self, ContactError> {
         let surfaces: Vec<Option<Surface>> = bodies.iter().map(Surface::of).collect();
         let mut patch_surfaces = Vec::with_capacity(bodies.len());
         for body in bodies {
@@ -108,7 +115,9 @@ impl Geometry {
             .iter()
             .map(|b| SHELL_REACH_MEMBERS * 100.0 * penetration_tolerance(b))
             .collect();
+        let own = SelfContact::new(bodies, self_contact, &surfaces, &patch_surfaces);
         Ok(Geometry {
+            own,
             surfaces,
             patch_surfaces,
             sides,
@@ -180,7 +189,8 @@ impl Geometry {
             Target::Obstacle(o) => self.obstacles.name(o),
             Target::Segment { body, .. }
             | Target::Vertex { body, .. }
-            | Target::Patch { body, .. } => &bodies[body].name,
+            | Target::Patch { body, .. }
+            | Target::Closing { body, .. } => &bodies[body].name,
             Target::Sharp { obstacle, .. } => self.obstacles.name(obstacle),
         }
     }
@@ -198,6 +208,7 @@ impl Geometry {
         active: &ContactSet,
     ) {
         let min_depth = min_depth(parts);
+        self.own.record(bodies, parts, active);
         for shell in 0..self.patch_surfaces.len() {
             let Some(surface) = self.patch_surfaces[shell].as_ref().filter(|s| s.is_open()) else {
                 continue;
@@ -274,7 +285,7 @@ impl Geometry {
         let before: HashMap<(usize, usize), Target> = solved
             .contacts
             .iter()
-            .filter(|c| !matches!(c.with, Target::Sharp { .. }))
+            .filter(|c| !matches!(c.with, Target::Sharp { .. } | Target::Closing { .. }))
             .map(|c| ((c.body, c.node), c.with))
             .collect();
         let mut changed = false;
@@ -375,6 +386,9 @@ impl Geometry {
                     .and_then(|s| s.mesh(|n| position(bodies, parts, b, n)))
             })
             .collect();
+        let own = self
+            .own
+            .grid(bodies, parts, &self.surfaces, &self.patch_surfaces);
         let mut found = Vec::new();
         for (b, body) in bodies.iter().enumerate() {
             for node in 0..body.nodes.len() {
@@ -438,6 +452,9 @@ impl Geometry {
                         consider(Target::Patch { body: other, patch }, depth);
                     }
                 }
+                if let Some((target, depth)) = self.own.deepest(&own, (b, node), &x, min_depth) {
+                    consider(target, depth);
+                }
                 if let Some((with, _)) = deepest {
                     found.push(ActiveContact {
                         body: b,
@@ -449,6 +466,7 @@ impl Geometry {
         }
         let sharp = self.sharp_points_inside(bodies, parts, offsets, &polygons, &meshes, &found);
         found.extend(sharp);
+        found.extend(self.own.closed_cracks(bodies, parts, min_depth));
         ContactSet::new(found)
     }
 }
@@ -682,7 +700,7 @@ pub(crate) fn candidate_nodes(
                     })
                 })
             };
-            mark[node] = near_body || near_obstacle();
+            mark[node] = geometry.own.is_on(b) || near_body || near_obstacle();
         }
         match (&geometry.patch_surfaces[b], &geometry.surfaces[b]) {
             (Some(p), _) => {

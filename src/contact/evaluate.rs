@@ -3,6 +3,7 @@
 use crate::contact::boundary::segment_projection;
 use crate::contact::detect::Geometry;
 use crate::contact::patch_surface::triangle_projection;
+use crate::contact::self_contact::closing;
 use crate::contact::settle::{position, BodyPart};
 use crate::contact::{
     return_mapping, ActiveContact, ContactSet, FrictionHistory, FrictionKey, Penalty, Tangential,
@@ -88,16 +89,17 @@ pub(crate) fn friction_key(c: &ActiveContact) -> (FrictionKey, Option<(usize, Re
             },
             Some((obstacle, 1.0)),
         ),
-        Target::Patch { body, .. } | Target::Segment { body, .. } | Target::Vertex { body, .. } => {
-            (
-                FrictionKey::Body {
-                    body: c.body,
-                    node: c.node,
-                    other: body,
-                },
-                None,
-            )
-        }
+        Target::Patch { body, .. }
+        | Target::Segment { body, .. }
+        | Target::Vertex { body, .. }
+        | Target::Closing { body, .. } => (
+            FrictionKey::Body {
+                body: c.body,
+                node: c.node,
+                other: body,
+            },
+            None,
+        ),
     }
 }
 
@@ -213,6 +215,14 @@ pub(crate) fn evaluate(
                 patch,
                 &offsets[obstacle],
             ),
+            Target::Closing { body, member } => {
+                closing(bodies, parts, body, member).map(|(depth, normal, nodes, penalty)| Touch {
+                    depth,
+                    normal,
+                    nodes,
+                    penalty,
+                })
+            }
         };
         let Some(Touch {
             depth,

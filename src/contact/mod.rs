@@ -14,6 +14,7 @@ pub use self::obstacles::{mesh_collider, primitive_collider, ObstacleProjection,
 pub use self::patch_surface::{PatchSurface, SurfaceProblem};
 pub use self::penalty::{default_penalty, penetration_tolerance, Penalty, PENALTY_FACTOR};
 pub use self::report::ContactStep;
+pub use self::self_contact::{self_contact_on, SELF_REACH_MEMBERS, SELF_RINGS};
 pub use self::settings::ContactSettings;
 pub use self::settle::ContactSolver;
 pub use self::start::StartOverlap;
@@ -39,6 +40,7 @@ mod obstacles;
 mod patch_surface;
 mod penalty;
 mod report;
+mod self_contact;
 mod settings;
 mod settle;
 mod start;

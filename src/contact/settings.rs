@@ -20,6 +20,10 @@ pub struct ContactSettings {
     pub condense: bool,
     /// Coulomb friction of the contact pairs (frictionless by default).
     pub friction: FrictionSettings,
+    /// Contact of every body with itself (`[contact] self`): its surface nodes against its own
+    /// surface, and its closed cracks (see [`crate::contact::self_contact_on`]); `None`: on
+    /// for bodies with breaking members only.
+    pub self_contact: Option<bool>,
 }
 
 impl Default for ContactSettings {
@@ -30,6 +34,7 @@ impl Default for ContactSettings {
             max_iterations: 50,
             condense: true,
             friction: FrictionSettings::default(),
+            self_contact: None,
         }
     }
 }

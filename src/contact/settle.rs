@@ -241,7 +241,7 @@ impl ContactSolver {
             assembly: t.elapsed().as_secs_f64(),
             ..Default::default()
         };
-        let geometry = Geometry::new(bodies, obstacles)?;
+        let geometry = Geometry::new(bodies, obstacles, settings.self_contact)?;
         no_start_overlap(bodies, &parts, &geometry)?;
         let mut condensed = None;
         let mut mechanism = None;

@@ -267,5 +267,6 @@ pub(crate) fn contact_settings(spec: Option<&ContactSpec>) -> Result<ContactSett
         settings.max_iterations = n;
     }
     settings.condense = spec.condense.unwrap_or(settings.condense);
+    settings.self_contact = spec.self_contact;
     Ok(settings)
 }

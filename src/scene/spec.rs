@@ -55,6 +55,10 @@ pub struct ContactSpec {
     pub friction: Option<Real>,
     /// Tangential stiffness of sticking, N/m of elastic slip (default: the normal penalty).
     pub stick_stiffness: Option<Real>,
+    /// Contact of every body with itself (`self = true`; default: bodies with breaking
+    /// members only; `false`: none).
+    #[serde(rename = "self")]
+    pub self_contact: Option<bool>,
     /// Pairs with their own friction.
     #[serde(default)]
     pub pairs: Vec<Spanned<ContactPairSpec>>,
