@@ -234,3 +234,172 @@ penalty = {k:e}
         assert!(f.as_f64().unwrap().abs() <= 1e-6 * p0, "{f}");
     }
 }
+
+/// Write and run a 2D contact scene of steel members (E A = 2e7 N, f_t A = 25 kN, breaking;
+/// `strong`: the same, not breaking), penalty 1e9 N/m.
+fn run_contact_scene(
+    d: &std::path::Path,
+    name: &str,
+    nodes: &str,
+    links: &str,
+    rest: &str,
+) -> linkage::scene::Summary {
+    std::fs::write(d.join(format!("{name}.nodes")), nodes).unwrap();
+    std::fs::write(d.join(format!("{name}.links")), links).unwrap();
+    let scene = d.join(format!("{name}.toml"));
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "{name}"
+steps = 4
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+tensile_strength = 250e6
+failure = "break"
+[[materials]]
+name = "strong"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "truss"
+nodes = "{name}.nodes"
+links = "{name}.links"
+material = "steel"
+[contact]
+penalty = 1e9
+{rest}"#
+        ),
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    run(&world, &d.join("out"), &|| {}).expect("a result")
+}
+
+fn step_json(d: &std::path::Path, name: &str, step: usize) -> serde_json::Value {
+    let text = std::fs::read_to_string(d.join(format!("out/{name}/steps/{step:04}.json"))).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// A piece cut loose that no contact holds falls off, in a contact scene: a triangle of strong
+/// members (nodes 1 (0, 0) and 2 (2, 0) pinned, apex 3 (1, 1)) pressed at its apex by a
+/// half-space 1 mm above it coming down 3 mm over 4 steps, and node 4 (1, −1) hung below
+/// nodes 1 and 2 by two breaking members at 45° (members 4 and 5), pulled down by P up to
+/// 50 kN. Each hanger carries P/√2 whatever the press does (their other ends are pinned): they
+/// reach f_t A at P = √2 f_t A, load factor 0.7071 (to 1e-9), in step 3; member 4 breaks (ties
+/// by number) and node 4, left on one member, is reported fallen and removed, and the run goes
+/// on. At step 4 the triangle alone carries the press: the apex's vertical stiffness is
+/// K = E A/√2 (two bars at 45°), so the press pushes `F = k K (T − gap)/(k + K)` (1e-9), the
+/// reactions answer it, and the fallen node's load is gone.
+#[test]
+fn a_piece_cut_loose_that_no_contact_holds_falls_off_and_the_run_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let summary = run_contact_scene(
+        d,
+        "pendant",
+        "0 0\n2 0\n1 1\n1 -1\n",
+        "1 2 strong\n1 3 strong\n2 3 strong\n1 4\n2 4\n",
+        r#"[[bodies.supports]]
+nodes = [1, 2]
+fix = ["x", "y"]
+[[bodies.loads]]
+nodes = [4]
+force = [0.0, -50000.0]
+[[obstacles]]
+name = "press"
+shape = "half_space"
+point = [0.0, 1.001]
+normal = [0.0, -1.0]
+travel = [0.0, -0.003]
+"#,
+    );
+    assert!(summary.collapse.is_none() && summary.failure.is_none());
+    assert_eq!(summary.steps.len(), 5);
+    assert_eq!(summary.breaks.len(), 1, "{:?}", summary.breaks);
+    let b = &summary.breaks[0];
+    assert_eq!((b.step, b.member), (3, 4));
+    let expected = 25e3 * 2f64.sqrt() / 50e3;
+    assert!(close(b.load_factor, expected, 1e-9), "{}", b.load_factor);
+    assert_eq!(
+        step_json(d, "pendant", 3)["bodies"][0]["fallen"],
+        serde_json::json!([4])
+    );
+    assert!(summary.steps[3]
+        .warnings
+        .iter()
+        .any(|w| w.contains("fell off")));
+    let step4 = step_json(d, "pendant", 4);
+    let body = &step4["bodies"][0];
+    assert_eq!(body["broken"], serde_json::json!([4]));
+    assert!(body.get("fallen").is_none());
+    assert_eq!(body["axial_forces"][3].as_f64().unwrap(), 0.0);
+    assert_eq!(body["axial_forces"][4].as_f64().unwrap(), 0.0);
+    let (ea, k, gap, travel) = (2e7, 1e9, 1e-3, 3e-3);
+    let big_k = ea / 2f64.sqrt();
+    let press = k * big_k * (travel - gap) / (k + big_k);
+    let contacts = body["contacts"].as_array().unwrap();
+    assert_eq!(contacts.len(), 1, "{contacts:?}");
+    assert_eq!(contacts[0]["node"], 3);
+    let fy = contacts[0]["force"][1].as_f64().unwrap();
+    assert!(close(-fy, press, 1e-9), "{fy} against {press}");
+    let mut sum = [0.0f64; 2];
+    for r in body["reactions"].as_array().unwrap() {
+        for k in 0..2 {
+            sum[k] += r["force"][k].as_f64().unwrap();
+        }
+    }
+    let loads: f64 = body["loads"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["force"][1].as_f64().unwrap().abs())
+        .sum();
+    assert_eq!(loads, 0.0, "the fallen node's load is dropped");
+    assert!(sum[0].abs() <= 1e-9 * press, "{sum:?}");
+    assert!(close(sum[1], press, 1e-9), "{sum:?} against {press}");
+}
+
+/// A piece cut loose that rests on an obstacle is held: node 3 (1, −1) hung below the pinned
+/// nodes 1 (0, 0) and 2 (2, 0) by two breaking members (tension only), 0.1 mm above a floor,
+/// pulled by (H, −V) = (40, −20) kN times the load factor over 4 steps. It reaches the floor
+/// early; member 1 (stretched by H) breaks in step 4. Node 3 is then left on member 2 and its
+/// floor contact: a determinate node, held, not fallen. At the last step member 2 pushes
+/// `−√2 H` and the floor `V + H` (1e-9).
+#[test]
+fn a_piece_cut_loose_that_rests_on_an_obstacle_is_held() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let summary = run_contact_scene(
+        d,
+        "resting",
+        "0 0\n2 0\n1 -1\n",
+        "1 3\n2 3\n",
+        r#"[[bodies.supports]]
+nodes = [1, 2]
+fix = ["x", "y"]
+[[bodies.loads]]
+nodes = [3]
+force = [40000.0, -20000.0]
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, -1.0001]
+normal = [0.0, 1.0]
+"#,
+    );
+    assert!(summary.collapse.is_none() && summary.failure.is_none());
+    assert_eq!(summary.breaks.len(), 1, "{:?}", summary.breaks);
+    assert_eq!(summary.breaks[0].member, 1);
+    let last = step_json(d, "resting", 4);
+    let body = &last["bodies"][0];
+    assert!(body.get("fallen").is_none(), "{body}");
+    assert_eq!(body["broken"], serde_json::json!([1]));
+    let n2 = body["axial_forces"][1].as_f64().unwrap();
+    assert!(close(n2, -2f64.sqrt() * 40e3, 1e-9), "{n2}");
+    let contacts = body["contacts"].as_array().unwrap();
+    assert_eq!(contacts.len(), 1, "{contacts:?}");
+    let r = contacts[0]["normal_force"].as_f64().unwrap();
+    assert!(close(r, 60e3, 1e-9), "{r}");
+}

@@ -81,6 +81,18 @@ impl CoupledSolver {
         Ok(())
     }
 
+    /// [`CoupledSolver::rebuild`] after a body's DOFs changed (a piece of it removed): the
+    /// entries between bodies, in the old numbering, are dropped and found again as contacts
+    /// need them. `false` when a body is solved iteratively (its solver cannot be rebuilt).
+    pub(crate) fn rebuild_renumbered(&mut self, parts: &[BodyPart]) -> Result<bool, ContactError> {
+        if self.iterative.is_some() {
+            return Ok(false);
+        }
+        self.coupling.clear();
+        self.rebuild(parts)?;
+        Ok(true)
+    }
+
     /// Conjugate-gradient iterations so far (0 when every body is solved directly).
     pub(crate) fn linear_iterations(&self) -> usize {
         self.iterative.as_ref().map_or(0, |i| i.iterations)

@@ -18,17 +18,24 @@
 //! its tooth's, [`Body::member_factors`]), so numbering, patterns, surfaces and the materials
 //! stay. Contact
 //! is solved on the coupled path for a scene with breaking bodies: the condensed path factors
-//! each body once per run, and a break changes its compliance. A break after which contact
-//! cannot be settled (a piece no support or contact holds, or the structure a mechanism) is the
-//! structure's collapse.
+//! each body once per run, and a break changes its compliance.
+//!
+//! A break after which contact cannot be settled may have cut a piece loose. A piece held by
+//! contact settles like the rest. Otherwise the pieces the break left without support (as
+//! without contact: connected parts without supports, and nodes on fewer intact members than
+//! their DOFs, see [`released_pieces`]) that touch nothing in the last settled contact set are
+//! removed from the solve: they fell off. Their members carry nothing from then on, their loads
+//! are dropped, their nodes are held where they were made (undeformed) and are no longer looked
+//! for contacts, and contact is settled again. When nothing can be removed, or contact still
+//! cannot be settled, the break is the structure's collapse.
 
-use crate::contact::{ContactError, ContactSolver, ContactStep, Obstacle};
+use crate::contact::{ContactError, ContactSolver, ContactStep, Obstacle, Target};
 use crate::linkage::body_state::{linear_stretch, undeformed_axis};
 use crate::linkage::fracture::{
-    breaks_members, critical_fraction, member_limits, BreakEvent, FractureState, MemberLimits,
-    Tooth,
+    breaks_members, critical_fraction, member_limits, released_pieces, BreakEvent, FallenPiece,
+    FractureState, MemberLimits, Tooth,
 };
-use crate::linkage::{Body, SolveError};
+use crate::linkage::{Body, DofMap, SolveError, StiffnessAssembly, Support};
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -82,6 +89,8 @@ pub struct ContactFracture {
     breaking: Vec<Option<Breaking>>,
     /// Per breaking body its members' stresses (Pa) at the end of the last step solved.
     last: Vec<Vec<Real>>,
+    /// Per body, its nodes removed with pieces that fell off.
+    fallen: Vec<Vec<bool>>,
     /// The pseudo-time of the solver's current state.
     now: Real,
 }
@@ -122,6 +131,7 @@ impl ContactFracture {
             bodies: bodies.to_vec(),
             original: bodies.to_vec(),
             last: bodies.iter().map(|b| vec![0.0; b.members.len()]).collect(),
+            fallen: bodies.iter().map(|b| vec![false; b.nodes.len()]).collect(),
             breaking,
             now: 0.0,
         }))
@@ -251,6 +261,18 @@ impl ContactFracture {
         steps: usize,
     ) -> Result<(ContactStep, Vec<Option<FractureState>>), FractureStop> {
         if step == 0 {
+            if self.fallen.iter().flatten().any(|&f| f) {
+                // The solver holds the removed nodes: give it the whole bodies back.
+                for (b, body) in self.original.iter().enumerate() {
+                    if self.fallen[b].iter().any(|&f| f) {
+                        refit_body(solver, b, body)?;
+                    }
+                }
+                solver.removed.clear();
+                self.fallen
+                    .iter_mut()
+                    .for_each(|f| f.iter_mut().for_each(|v| *v = false));
+            }
             self.bodies = self.original.clone();
             let fresh = ContactFracture::new(&self.original)
                 .ok()
@@ -263,9 +285,10 @@ impl ContactFracture {
                 l.iter_mut().for_each(|v| *v = 0.0);
             }
         }
-        let mut out = solver.solve_step(&self.bodies, obstacles, step, steps)?;
+        let out = solver.settle_step(&self.bodies, obstacles, step, steps)?;
         self.now = step as Real;
         let mut events: Vec<Vec<BreakEvent>> = vec![Vec::new(); self.bodies.len()];
+        let mut fallen: Vec<Vec<FallenPiece>> = vec![Vec::new(); self.bodies.len()];
         if step > 0 {
             let end = step as Real;
             let (mut t_lo, mut lo) = (end - 1.0, self.last.clone());
@@ -279,29 +302,35 @@ impl ContactFracture {
                     fraction: t_break - (end - 1.0),
                     tooth,
                 });
-                let collapse = |events: &mut Vec<Vec<BreakEvent>>| FractureStop::Collapse {
-                    body: b,
-                    member: m,
-                    breaks: std::mem::take(&mut events[b]),
-                };
                 // The state just after the break, at its load, then at the step's.
-                if self
-                    .settle(solver, obstacles, t_break, (step, steps))
-                    .is_err()
-                {
-                    return Err(collapse(&mut events));
-                }
-                (t_lo, lo) = (t_break, self.stresses(solver));
-                if self.settle(solver, obstacles, end, (step, steps)).is_err() {
-                    return Err(collapse(&mut events));
+                for t in [t_break, end] {
+                    if !self.settle_or_release(
+                        solver,
+                        obstacles,
+                        t,
+                        (step, steps),
+                        b,
+                        m,
+                        &mut fallen[b],
+                    )? {
+                        return Err(FractureStop::Collapse {
+                            body: b,
+                            member: m,
+                            breaks: std::mem::take(&mut events[b]),
+                        });
+                    }
+                    if t == t_break {
+                        (t_lo, lo) = (t_break, self.stresses(solver));
+                    }
                 }
                 hi = self.stresses(solver);
             }
             if events.iter().any(|e| !e.is_empty()) {
                 solver.restart_path();
-                out = solver.report(&self.bodies, obstacles, step, steps, out)?;
             }
         }
+        // Reported once, after the step's breaks.
+        let out = solver.report(&self.bodies, obstacles, step, steps, out)?;
         self.last = self.stresses(solver);
         let states = self
             .breaking
@@ -314,8 +343,126 @@ impl ContactFracture {
                     fallen: Vec::new(),
                 })
             })
+            .zip(fallen)
+            .map(|(state, pieces)| {
+                state.map(|mut s| {
+                    s.fallen = pieces;
+                    s
+                })
+            })
             .collect();
         Ok((out, states))
+    }
+
+    /// Settle at pseudo-time `t` after member `m` of body `b` broke; when contact cannot be
+    /// settled, remove the pieces of body `b` that fell off (appended to `fallen`) and settle
+    /// again. `false` when that cannot be done: the structure's collapse.
+    #[allow(clippy::too_many_arguments)]
+    fn settle_or_release(
+        &mut self,
+        solver: &mut ContactSolver,
+        obstacles: &[Obstacle],
+        t: Real,
+        steps: (usize, usize),
+        b: usize,
+        m: usize,
+        fallen: &mut Vec<FallenPiece>,
+    ) -> Result<bool, FractureStop> {
+        let saved = solver.converged_state();
+        let from = self.now;
+        if self.settle(solver, obstacles, t, steps).is_ok() {
+            return Ok(true);
+        }
+        solver.restore(saved);
+        self.now = from;
+        let pieces = self.loose_pieces(solver, b);
+        if pieces.is_empty() {
+            return Ok(false);
+        }
+        for nodes in &pieces {
+            self.remove_nodes(b, nodes);
+        }
+        if solver.removed.is_empty() {
+            solver.removed = self.fallen.clone();
+        } else {
+            solver.removed[b] = self.fallen[b].clone();
+        }
+        if !refit_body(solver, b, &self.bodies[b])? {
+            return Ok(false);
+        }
+        fallen.extend(
+            pieces
+                .into_iter()
+                .map(|nodes| FallenPiece { member: m, nodes }),
+        );
+        Ok(self.settle(solver, obstacles, t, steps).is_ok())
+    }
+
+    /// The pieces of body `b` without support (see [`released_pieces`]) none of whose nodes
+    /// touches anything in the solver's contact set.
+    fn loose_pieces(&self, solver: &ContactSolver, b: usize) -> Vec<Vec<usize>> {
+        let body = &self.bodies[b];
+        let members: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
+        let intact: Vec<bool> = (0..members.len())
+            .map(|j| body.modulus_factor(j) > 0.0)
+            .collect();
+        let dofs = &solver.parts[b].dofs;
+        let mut supported = vec![false; body.nodes.len()];
+        for &dof in &dofs.supported {
+            supported[dof / dofs.dofs_per_node] = true;
+        }
+        let mut touching = vec![false; body.nodes.len()];
+        for c in &solver.active.contacts {
+            match c.with {
+                Target::Sharp { .. } => {}
+                _ if c.body == b => touching[c.node] = true,
+                _ => {}
+            }
+            let (Target::Segment { body: o, .. }
+            | Target::Patch { body: o, .. }
+            | Target::Vertex { body: o, .. }) = c.with
+            else {
+                continue;
+            };
+            if o == b {
+                // Another body presses on this one: both are held together.
+                touching.iter_mut().for_each(|t| *t = true);
+            }
+        }
+        released_pieces(
+            &members,
+            &intact,
+            &supported,
+            &self.fallen[b],
+            dofs.dofs_per_node,
+        )
+        .into_iter()
+        .filter(|piece| !piece.iter().any(|&n| touching[n]))
+        .collect()
+    }
+
+    /// Take `nodes` of body `b` out of the solve: their members carry nothing, their loads are
+    /// dropped, and they are held where they were made.
+    fn remove_nodes(&mut self, b: usize, nodes: &[usize]) {
+        let body = &mut self.bodies[b];
+        for &n in nodes {
+            self.fallen[b][n] = true;
+        }
+        if body.member_factors.len() != body.members.len() {
+            body.member_factors = vec![1.0; body.members.len()];
+        }
+        let gone = &self.fallen[b];
+        for (j, member) in body.members.iter().enumerate() {
+            if member.nodes.iter().any(|&n| gone[n]) {
+                body.member_factors[j] = 0.0;
+                if let Some(br) = self.breaking[b].as_mut() {
+                    br.factor[j] = 0.0;
+                }
+            }
+        }
+        body.loads.retain(|l| !gone[l.node]);
+        body.supports
+            .extend(nodes.iter().map(|&n| Support::fixed(n, [true; 3])));
     }
 
     /// The first member to reach its strength between the settled state at pseudo-time `t_lo`
@@ -373,4 +520,17 @@ impl ContactFracture {
         self.settle(solver, obstacles, t_hi, (step, steps))?;
         Ok(Some((b, m, t_hi)))
     }
+}
+
+/// Give the solver body `b`'s supports anew (nodes removed or given back): its DOF map, its
+/// stiffness pattern and the coupled system. `false` when the coupled system cannot be rebuilt
+/// (a body solved iteratively).
+fn refit_body(solver: &mut ContactSolver, b: usize, body: &Body) -> Result<bool, ContactError> {
+    let dofs = DofMap::new(body);
+    let assembly = StiffnessAssembly::new(body, &dofs).map_err(SolveError::from)?;
+    let part = &mut solver.parts[b];
+    part.dofs = dofs;
+    part.assembly = assembly;
+    part.local.clear();
+    solver.coupled.rebuild_renumbered(&solver.parts)
 }

@@ -21,7 +21,7 @@ use std::collections::HashMap;
 use std::time::Instant;
 
 /// What an increment is undone to: the last converged state.
-struct Converged {
+pub(crate) struct Converged {
     u: Vec<Vec<Real>>,
     active: ContactSet,
     normals: HashMap<ActiveContact, Vector3<Real>>,
@@ -34,6 +34,21 @@ impl ContactSolver {
     /// once is crossed in halved increments (`cuts` in the result); it fails when an increment
     /// of `1/2^max_cuts` of a step (the smallest `[bodies.newton] max_cuts`) still fails.
     pub fn solve_step(
+        &mut self,
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        step: usize,
+        steps: usize,
+    ) -> Result<ContactStep, ContactError> {
+        let out = self.settle_step(bodies, obstacles, step, steps)?;
+        let reported = self.report(bodies, obstacles, step, steps, out)?;
+        self.commit_friction(bodies, obstacles, step as Real, steps, step);
+        Ok(reported)
+    }
+
+    /// [`ContactSolver::solve_step`] without the report of the settled state (its counts
+    /// only): fracture reports a step once its members have broken.
+    pub(crate) fn settle_step(
         &mut self,
         bodies: &[Body],
         obstacles: &[Obstacle],
@@ -134,9 +149,7 @@ impl ContactSolver {
             }
         }
         out.cuts = size.cuts;
-        let reported = self.report(bodies, obstacles, step, steps, out)?;
-        self.commit_friction(bodies, obstacles, end, steps, step);
-        Ok(reported)
+        Ok(out)
     }
 
     /// Settle at pseudo-time `t` of `steps` (within `step`) from the current state, solved at
@@ -299,7 +312,7 @@ impl ContactSolver {
     }
 
     /// The state an increment starts from.
-    fn converged_state(&self) -> Converged {
+    pub(crate) fn converged_state(&self) -> Converged {
         Converged {
             u: self.parts.iter().map(|p| p.u.clone()).collect(),
             active: self.active.clone(),
@@ -308,7 +321,7 @@ impl ContactSolver {
     }
 
     /// Undo a failed increment.
-    fn restore(&mut self, saved: Converged) {
+    pub(crate) fn restore(&mut self, saved: Converged) {
         for (p, u) in self.parts.iter_mut().zip(saved.u) {
             p.u = u;
         }

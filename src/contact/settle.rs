@@ -9,7 +9,7 @@ use crate::contact::report::{finish, ContactStep};
 use crate::contact::start::{no_start_overlap, one_dimension};
 use crate::contact::{
     default_penalty, penetration_tolerance, ActiveContact, ContactError, ContactSet,
-    ContactSettings, FrictionHistory, Obstacle, Penalty,
+    ContactSettings, FrictionHistory, Obstacle, Penalty, Target,
 };
 use crate::linkage::body_state::{loads_at, node_vector, prescribed_at};
 use crate::linkage::{
@@ -198,6 +198,9 @@ pub struct ContactSolver {
     pub times: PhaseTimes,
     /// Time spent so far finding contacts (projecting nodes on obstacles), s.
     pub query_seconds: Real,
+    /// Per body, its nodes removed from the solve (a piece that fell off: held in place,
+    /// touching nothing); empty when none is.
+    pub(crate) removed: Vec<Vec<bool>>,
 }
 
 impl ContactSolver {
@@ -315,6 +318,7 @@ impl ContactSolver {
             linear_before: 0,
             times,
             query_seconds: 0.0,
+            removed: Vec::new(),
         })
     }
 
@@ -376,7 +380,14 @@ impl ContactSolver {
         offsets: &[Vector3<Real>],
     ) -> ContactSet {
         let t = Instant::now();
-        let found = self.geometry.query(bodies, &self.parts, offsets);
+        let mut found = self.geometry.query(bodies, &self.parts, offsets);
+        if !self.removed.is_empty() {
+            let removed = &self.removed;
+            found.contacts.retain(|c| {
+                matches!(c.with, Target::Sharp { .. })
+                    || !removed.get(c.body).is_some_and(|r| r[c.node])
+            });
+        }
         let found = self
             .geometry
             .keep_patches(bodies, &self.parts, solved, found);

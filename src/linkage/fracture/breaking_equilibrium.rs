@@ -19,7 +19,7 @@
 use crate::linalg::{CholeskyError, LowRankUpdate, SparseCholesky};
 use crate::linkage::body_state::{linear_internal_forces, linear_stretch, undeformed_axis};
 use crate::linkage::fracture::{
-    critical_fraction, member_limits, saw_tooth, unsupported_pieces, BreakEvent, FallenPiece,
+    critical_fraction, member_limits, released_pieces, saw_tooth, BreakEvent, FallenPiece,
     FractureState, Tooth,
 };
 use crate::linkage::load_patterns::{solve_load_patterns, LoadPattern};
@@ -454,57 +454,23 @@ impl BreakingEquilibrium {
     /// found (nodes ascending, by first node), empty when the singular mode is elsewhere.
     fn release_pieces(&mut self, body: &Body) -> Vec<Vec<usize>> {
         let members: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
-        let d = self.dofs.dofs_per_node;
-        let mut released = vec![false; body.nodes.len()];
-        loop {
-            let intact: Vec<bool> = self.stiffness.iter().map(|&s| s > 0.0).collect();
-            let mut count = vec![0usize; body.nodes.len()];
-            for (m, &[a, b]) in members.iter().enumerate() {
-                if intact[m] {
-                    count[a] += 1;
-                    count[b] += 1;
-                }
-            }
-            let mut loose: Vec<usize> = (0..body.nodes.len())
-                .filter(|&n| {
-                    !self.fallen_node[n] && !self.supported_node[n] && count[n] > 0 && count[n] < d
-                })
-                .collect();
-            let pieces = unsupported_pieces(
-                body.nodes.len(),
-                &members,
-                &intact,
-                &self.supported_node,
-                &self.fallen_node,
-            );
-            loose.extend(pieces.iter().flatten());
-            if loose.is_empty() {
-                break;
-            }
-            for &n in &loose {
-                self.fallen_node[n] = true;
-                released[n] = true;
-            }
-            for (j, member) in body.members.iter().enumerate() {
-                if member.nodes.iter().any(|&n| self.fallen_node[n]) {
-                    self.stiffness[j] = 0.0;
-                }
+        let intact: Vec<bool> = self.stiffness.iter().map(|&s| s > 0.0).collect();
+        let pieces = released_pieces(
+            &members,
+            &intact,
+            &self.supported_node,
+            &self.fallen_node,
+            self.dofs.dofs_per_node,
+        );
+        for &n in pieces.iter().flatten() {
+            self.fallen_node[n] = true;
+        }
+        for (j, &[a, b]) in members.iter().enumerate() {
+            if self.fallen_node[a] || self.fallen_node[b] {
+                self.stiffness[j] = 0.0;
             }
         }
-        // The released nodes, grouped by the members they had before the break.
-        let intact_before: Vec<bool> = body
-            .members
-            .iter()
-            .map(|m| m.nodes.iter().all(|&n| released[n]))
-            .collect();
-        let not_released: Vec<bool> = released.iter().map(|r| !r).collect();
-        unsupported_pieces(
-            body.nodes.len(),
-            &members,
-            &intact_before,
-            &vec![false; body.nodes.len()],
-            &not_released,
-        )
+        pieces
     }
 
     /// Break the next member the load of `step` (of `steps`) breaks, if any, and return its

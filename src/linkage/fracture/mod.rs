@@ -5,7 +5,7 @@ pub use self::breaking_equilibrium::{
 };
 pub use self::critical::critical_fraction;
 pub use self::events::{breaks_members, BreakEvent, FallenPiece, FractureState};
-pub use self::pieces::unsupported_pieces;
+pub use self::pieces::{released_pieces, unsupported_pieces};
 pub use self::scatter::{member_limits, weibull_factors};
 pub use self::softening::{saw_tooth, saw_tooth_dissipation, Tooth};
 
