@@ -324,6 +324,10 @@ fn every_bundled_scene_is_in_equilibrium() {
     for path in scenes {
         let world = load_scene(&path).unwrap();
         let mut sim = Simulation::new(&world).unwrap();
+        // The balance is measured against the largest force the run has carried so far: once
+        // a body has broken apart (wedge_split's last steps) its forces fall by orders of
+        // magnitude, while the solution's absolute error stays that of the solves before.
+        let mut largest = 0.0f64;
         for step in 0..=world.steps {
             // A structure that collapses (paper_fracture) ends its run there: the steps before
             // it are checked.
@@ -355,6 +359,7 @@ fn every_bundled_scene_is_in_equilibrium() {
                 }
             }
             let norm = total.iter().map(|c| c * c).sum::<f64>().sqrt();
+            largest = largest.max(scale);
             // The balance below is vacuous without forces: at its last step every bundled
             // scene is loaded (by forces, prescribed displacements or contact).
             if step == world.steps {
@@ -365,7 +370,7 @@ fn every_bundled_scene_is_in_equilibrium() {
                 );
             }
             assert!(
-                norm <= 1e-9 * scale.max(1e-300) || scale == 0.0,
+                norm <= 1e-9 * largest.max(1e-300) || largest == 0.0,
                 "{}: step {step}: {norm}",
                 path.display()
             );
