@@ -378,3 +378,259 @@ fn self_with_a_nonsense_value_is_a_clear_error() {
         "{err}"
     );
 }
+
+/// Two cubes of 2 × 2 × 2 crossed cells (side 0.1 m, every cell's 8 corners joined pairwise)
+/// as ONE body, side by side along x with a gap of 0.04 m; outward surface patches. Returns
+/// the node, link and patch lines and the node positions.
+fn two_cubes() -> (String, String, String, Vec<[f64; 3]>) {
+    let (n, h, gap) = (2usize, 0.1, 0.04);
+    let side = n + 1;
+    let per_cube = side * side * side;
+    let id =
+        |cube: usize, i: usize, j: usize, l: usize| cube * per_cube + i + side * (j + side * l);
+    let mut positions = Vec::new();
+    for cube in 0..2 {
+        let x0 = cube as f64 * (n as f64 * h + gap);
+        for l in 0..side {
+            for j in 0..side {
+                for i in 0..side {
+                    positions.push([x0 + i as f64 * h, j as f64 * h, l as f64 * h]);
+                }
+            }
+        }
+    }
+    let mut links: Vec<(usize, usize)> = Vec::new();
+    let mut patches: Vec<[usize; 3]> = Vec::new();
+    for cube in 0..2 {
+        for l in 0..n {
+            for j in 0..n {
+                for i in 0..n {
+                    let corners: Vec<usize> = (0..8)
+                        .map(|c| id(cube, i + (c & 1), j + ((c >> 1) & 1), l + ((c >> 2) & 1)))
+                        .collect();
+                    for a in 0..8 {
+                        for b in a + 1..8 {
+                            let key = (corners[a].min(corners[b]), corners[a].max(corners[b]));
+                            if !links.contains(&key) {
+                                links.push(key);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // Each face: its outward axis, the side (0 or n) and in-plane axes (u, v) with
+        // u × v outward, so each quad's corners run counter-clockwise seen from outside.
+        for (axis, at, u, v) in [
+            (0, n, 1, 2),
+            (0, 0, 2, 1),
+            (1, n, 2, 0),
+            (1, 0, 0, 2),
+            (2, n, 0, 1),
+            (2, 0, 1, 0),
+        ] {
+            for a in 0..n {
+                for b in 0..n {
+                    let corner = |da: usize, db: usize| {
+                        let mut c = [0usize; 3];
+                        c[axis] = at;
+                        c[u] = a + da;
+                        c[v] = b + db;
+                        id(cube, c[0], c[1], c[2]) + 1
+                    };
+                    let (p, q, r, s) = (corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1));
+                    patches.push([p, q, r]);
+                    patches.push([p, r, s]);
+                }
+            }
+        }
+    }
+    let nodes = positions
+        .iter()
+        .map(|p| format!("{} {} {}\n", p[0], p[1], p[2]))
+        .collect();
+    let links = links
+        .iter()
+        .map(|(p, q)| format!("{} {}\n", p + 1, q + 1))
+        .collect();
+    let patches = patches
+        .iter()
+        .map(|t| format!("{} {} {}\n", t[0], t[1], t[2]))
+        .collect();
+    (nodes, links, patches, positions)
+}
+
+/// The two cubes of [`two_cubes`] as one body: each held on its outer face, the 9 nodes of
+/// each inner face pushed towards the other cube by `force` N each; `self_line` the
+/// `[contact]` line on self-contact.
+fn cubes_scene(dir: &Path, self_line: &str, force: f64) -> std::path::PathBuf {
+    let (nodes, links, patches, p) = two_cubes();
+    std::fs::write(dir.join("c.nodes"), nodes).unwrap();
+    std::fs::write(dir.join("c.links"), links).unwrap();
+    std::fs::write(dir.join("c.patches"), patches).unwrap();
+    let near = |x: f64| move |q: &[f64; 3]| (q[0] - x).abs() < 1e-9;
+    let outer: Vec<String> = [0.0, 0.44]
+        .iter()
+        .flat_map(|&x| {
+            p.iter()
+                .enumerate()
+                .filter(move |(_, q)| near(x)(q))
+                .map(|(i, _)| (i + 1).to_string())
+        })
+        .collect();
+    let list = |x: f64| -> String {
+        p.iter()
+            .enumerate()
+            .filter(|(_, q)| near(x)(q))
+            .map(|(i, _)| (i + 1).to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let scene = dir.join("c.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "cubes"
+steps = 4
+[[materials]]
+name = "m"
+youngs_modulus = 1e7
+area = 1e-4
+[[bodies]]
+name = "pair"
+nodes = "c.nodes"
+links = "c.links"
+patches = "c.patches"
+material = "m"
+[[bodies.supports]]
+nodes = [{outer}]
+fix = ["x", "y", "z"]
+[[bodies.loads]]
+nodes = [{left}]
+force = [{force}, 0.0, 0.0]
+[[bodies.loads]]
+nodes = [{right}]
+force = [{minus}, 0.0, 0.0]
+[contact]
+{self_line}
+"#,
+            outer = outer.join(", "),
+            left = list(0.2),
+            right = list(0.24),
+            minus = -force
+        ),
+    )
+    .unwrap();
+    scene
+}
+
+/// 3D: two pieces of one body (two cubes, each held on its outer face) whose inner faces are
+/// pushed towards each other. Without self-contact the faces pass through each other (each
+/// moves past the middle plane x = 0.22 m); with `self = true` they meet there and stay apart
+/// (no node of the left cube beyond the middle by more than 1 mm), the contact forces on the
+/// two cubes are equal and opposite (1e-9 of their size), and the set-up's mirror symmetry
+/// about the middle plane holds in the answer to 1e-3 of the largest displacement (see below
+/// why not to round-off).
+#[test]
+fn two_pieces_of_one_3d_body_pressed_together_touch_and_do_not_pass_through() {
+    let (_, _, _, p) = two_cubes();
+    let force = 500.0;
+    let middle = 0.22;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cubes_scene(dir.path(), "self = false", force);
+    let out = dir.path().join("out");
+    let summary = run(&load_scene(&scene).unwrap(), &out, &|| {}).expect("a result");
+    assert!(summary.failure.is_none());
+    let step = step_file(&out, "cubes", 4);
+    let positions = step["bodies"][0]["positions"].as_array().unwrap();
+    let deepest_left = (0..p.len())
+        .filter(|&i| p[i][0] < middle)
+        .map(|i| vector(&positions[i])[0])
+        .fold(f64::NEG_INFINITY, f64::max);
+    eprintln!("self = false: the left cube reaches x = {deepest_left} m");
+    assert!(
+        deepest_left > middle + 0.005,
+        "without self-contact the left cube reaches only x = {deepest_left}"
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let scene = cubes_scene(dir.path(), "self = true", force);
+    let out = dir.path().join("out");
+    let summary = run(&load_scene(&scene).unwrap(), &out, &|| {}).expect("a result");
+    assert!(summary.failure.is_none());
+    let last = summary.steps.last().unwrap();
+    assert!(last.warnings.is_empty(), "{:?}", last.warnings);
+    let step = step_file(&out, "cubes", 4);
+    let body = &step["bodies"][0];
+    let positions: Vec<Vec<f64>> = body["positions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(vector)
+        .collect();
+    let u: Vec<Vec<f64>> = body["displacements"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(vector)
+        .collect();
+    // Members of 0.1, 0.1 √2 and 0.1 √3 m: the tolerance is 1% of their mean, at least 1 mm.
+    let tolerance = 0.001;
+    let deepest_left = (0..p.len())
+        .filter(|&i| p[i][0] < middle)
+        .map(|i| positions[i][0])
+        .fold(f64::NEG_INFINITY, f64::max);
+    eprintln!("self = true: the left cube reaches x = {deepest_left} m");
+    assert!(
+        deepest_left < middle + tolerance,
+        "the left cube passed the middle: x = {deepest_left}"
+    );
+    assert!(deepest_left > middle - 0.02, "the cubes did not meet");
+    // Contact forces on each cube: equal and opposite.
+    let mut on = [[0.0f64; 3]; 2];
+    let contacts = body["contacts"].as_array().unwrap();
+    assert!(!contacts.is_empty());
+    for c in contacts {
+        let node = c["node"].as_u64().unwrap() as usize - 1;
+        let f = vector(&c["force"]);
+        let side = usize::from(p[node][0] > middle);
+        for k in 0..3 {
+            on[side][k] += f[k];
+        }
+    }
+    let size = on[0][0].abs();
+    eprintln!(
+        "contact force on the left cube {:?}, on the right {:?}",
+        on[0], on[1]
+    );
+    assert!(
+        size > 0.1 * 9.0 * force,
+        "the contact carries only {size} N"
+    );
+    for k in 0..3 {
+        assert!((on[0][k] + on[1][k]).abs() <= 1e-9 * size, "{on:?}");
+    }
+    // Mirror symmetry about x = middle: node i of the left cube mirrors node mirror(i) of the
+    // right one (i, j, l) -> (2 - i, j, l); its x displacement is opposite, y and z the same.
+    let largest = u
+        .iter()
+        .map(|d| d.iter().map(|c| c * c).sum::<f64>().sqrt())
+        .fold(0.0, f64::max);
+    // The faces' nodes meet the other face's patch corners, where several patches tie: each
+    // node presses the first of them in patch order, which is not mirror-symmetric, so the
+    // answer is symmetric to 1.4e-4 of the largest displacement here, not to round-off.
+    let mut worst = 0.0f64;
+    for i in 0..27 {
+        let (a, j, l) = (i % 3, (i / 3) % 3, i / 9);
+        let m = 27 + (2 - a) + 3 * (j + 3 * l);
+        worst = worst
+            .max((u[i][0] + u[m][0]).abs())
+            .max((u[i][1] - u[m][1]).abs())
+            .max((u[i][2] - u[m][2]).abs());
+    }
+    eprintln!(
+        "mirror symmetry to {} of the largest displacement",
+        worst / largest
+    );
+    assert!(worst <= 1e-3 * largest, "mirror symmetry broken by {worst}");
+}

@@ -52,9 +52,11 @@ pub const SELF_RINGS: usize = 2;
 pub const SELF_REACH_MEMBERS: Real = 1.5;
 
 /// A foot this far (a fraction of the segment or patch) beyond its end or edge still lies on
-/// it: round-off does not let a node slip between two segments, or past the corner it meets in
-/// a mirror-symmetric set-up.
-const ON: Real = 1e-9;
+/// it. Not round-off only: where a pressed face bends outward between two patches (a ridge), a
+/// node just behind it projects beyond the edge of both, and with a margin of round-off it
+/// would press neither and pass through (two cubes of one body pushed face to face did, with
+/// 1e-9); the nearest of the patches it lies on within this margin holds it.
+const ON: Real = 0.05;
 
 /// Whether self-contact is on for `body`: `setting` when given (`[contact] self`), else for a
 /// body with breaking members.
