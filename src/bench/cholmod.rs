@@ -8,7 +8,7 @@
 use crate::linalg::cholesky::{CholeskyOptions, SparseCholesky};
 use crate::linalg::SymmetricCsr;
 use crate::linkage::generators::lattice_body;
-use crate::linkage::{axial_stiffness, member_block, DofMap, StiffnessAssembly};
+use crate::linkage::{linear_member_block, DofMap, StiffnessAssembly};
 use crate::scene::npz_archive::{NpzIn, NpzOut};
 use crate::Real;
 use std::time::Instant;
@@ -40,16 +40,7 @@ pub fn lattice_system(cells: [usize; 3]) -> Result<(LowerSystem, usize), String>
     let dofs = DofMap::new(&body);
     let asm = StiffnessAssembly::new(&body, &dofs).map_err(|e| e.to_string())?;
     let mut values = Vec::new();
-    asm.fill(
-        &body,
-        |m| {
-            let [a, b] = body.members[m].nodes;
-            let material = &body.materials[body.members[m].material];
-            let k = axial_stiffness(material, body.member_length(m));
-            member_block(&body.nodes[a], &body.nodes[b], k)
-        },
-        &mut values,
-    );
+    asm.fill(&body, |m| linear_member_block(&body, m), &mut values);
     let mut rhs = vec![0.0; asm.n];
     for l in &body.loads {
         for k in 0..dofs.dofs_per_node {

@@ -130,21 +130,13 @@ pub fn measure_iterative(cells: [usize; 3], multigrid: bool) -> Result<Iterative
         conjugate_gradient, BlockJacobi, CgSettings, Preconditioner, SmoothedAggregation,
         SymmetricCsr,
     };
-    use crate::linkage::{axial_stiffness, DofMap, StiffnessAssembly};
+    use crate::linkage::{linear_member_block, DofMap, StiffnessAssembly};
     let body = lattice_body(cells).map_err(|e| e.to_string())?;
     let t = Instant::now();
     let dofs = DofMap::new(&body);
     let asm = StiffnessAssembly::new(&body, &dofs).map_err(|e| e.to_string())?;
     let mut values = Vec::new();
-    asm.fill(
-        &body,
-        |m| {
-            let [a, b] = body.members[m].nodes;
-            let k = axial_stiffness(&body.materials[0], body.member_length(m));
-            crate::linkage::member_block(&body.nodes[a], &body.nodes[b], k)
-        },
-        &mut values,
-    );
+    asm.fill(&body, |m| linear_member_block(&body, m), &mut values);
     let mut csr = SymmetricCsr::from_lower(asm.n, &asm.col_ptr, &asm.row_idx);
     csr.refill(&values);
     drop(values);

@@ -13,11 +13,25 @@ pub fn axial_stiffness(material: &Material, length: Real) -> Real {
 /// material's times its factor, [`Body::member_modulus`]).
 pub fn member_stiffnesses(body: &Body) -> Vec<Real> {
     (0..body.members.len())
-        .map(|m| {
-            body.materials[body.members[m].material].area * body.member_modulus(m)
-                / body.member_length(m)
-        })
+        .map(|m| member_axial_stiffness(body, m))
         .collect()
+}
+
+/// The axial stiffness `A E / L` of member `m` of `body`, N/m (`E` its material's times its
+/// factor, [`Body::member_modulus`]).
+pub fn member_axial_stiffness(body: &Body, m: usize) -> Real {
+    body.materials[body.members[m].material].area * body.member_modulus(m) / body.member_length(m)
+}
+
+/// The linear stiffness block `(A E / L) n nᵀ` of member `m` of `body` at rest, N/m (paper
+/// Eq. 1–2; see [`member_block`]).
+pub fn linear_member_block(body: &Body, m: usize) -> Matrix3<Real> {
+    let [a, b] = body.members[m].nodes;
+    member_block(
+        &body.nodes[a],
+        &body.nodes[b],
+        member_axial_stiffness(body, m),
+    )
 }
 
 /// The 3×3 block `k n nᵀ` of a member from `a` to `b` (n the unit axis): the member matrix of

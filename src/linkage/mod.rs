@@ -18,7 +18,8 @@ pub use self::mechanism::Mechanism;
 pub use self::member_check::check_members;
 pub use self::member_response::{member_response, scaled_member_response, MemberResponse};
 pub use self::member_stiffness::{
-    axial_stiffness, member_block, member_stiffness_matrix, member_stiffnesses,
+    axial_stiffness, linear_member_block, member_axial_stiffness, member_block,
+    member_stiffness_matrix, member_stiffnesses,
 };
 pub use self::newton::NewtonEquilibrium;
 pub(crate) use self::newton::{lagrange_weights, IncrementSize};

@@ -5,7 +5,7 @@ use crate::linalg::multigrid::MODES;
 use crate::linalg::SymmetricCsr;
 use crate::linkage::generators::lattice_body;
 use crate::linkage::rigid_modes::rigid_body_rows;
-use crate::linkage::{axial_stiffness, member_block, DofMap, StiffnessAssembly};
+use crate::linkage::{linear_member_block, DofMap, StiffnessAssembly};
 use crate::Real;
 
 /// `K_ff` of a lattice of `cells` with its bottom face fixed (see [`lattice_body`]).
@@ -24,15 +24,7 @@ pub(crate) fn lattice_system(cells: [usize; 3]) -> LatticeSystem {
     let dofs = DofMap::new(&body);
     let assembly = StiffnessAssembly::new(&body, &dofs).expect("small lattice");
     let mut values = Vec::new();
-    assembly.fill(
-        &body,
-        |m| {
-            let [a, b] = body.members[m].nodes;
-            let k = axial_stiffness(&body.materials[0], body.member_length(m));
-            member_block(&body.nodes[a], &body.nodes[b], k)
-        },
-        &mut values,
-    );
+    assembly.fill(&body, |m| linear_member_block(&body, m), &mut values);
     let mut matrix = SymmetricCsr::from_lower(assembly.n, &assembly.col_ptr, &assembly.row_idx);
     matrix.refill(&values);
     let near_null_space = rigid_body_rows(&body.nodes, &dofs);

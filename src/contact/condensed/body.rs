@@ -6,7 +6,7 @@ use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::rigid_modes::{free_rigid_modes, pinned_dofs_avoiding};
 use crate::linkage::Mechanism;
 use crate::linkage::{
-    member_block, prescribed_displacements, Body, DofMap, Schedule, StiffnessAssembly,
+    linear_member_block, prescribed_displacements, Body, DofMap, Schedule, StiffnessAssembly,
 };
 use crate::Real;
 use faer::Mat;
@@ -140,7 +140,7 @@ impl CondensedBody {
         let symbolic = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
         let mut values = Vec::new();
-        assembly.fill(body, |k| linear_block(body, k), &mut values);
+        assembly.fill(body, |k| linear_member_block(body, k), &mut values);
         let mut pinned = vec![false; n];
         for &p in &pins {
             pinned[p] = true;
@@ -387,18 +387,6 @@ fn far_from(body: &Body, marked: &[bool]) -> Vec<bool> {
         .iter()
         .map(|&d| d != usize::MAX && 4 * d >= 3 * largest)
         .collect()
-}
-
-/// The linear stiffness block `(E A / L) n nᵀ` of member `m`, N/m (paper Eq. 1–2).
-fn linear_block(body: &Body, m: usize) -> nalgebra::Matrix3<Real> {
-    let member = body.members[m];
-    let [a, b] = member.nodes;
-    let material = &body.materials[member.material];
-    member_block(
-        &body.nodes[a],
-        &body.nodes[b],
-        body.member_modulus(m) * material.area / body.member_length(m),
-    )
 }
 
 /// `(L Lᵀ)⁻¹` for a dense lower-triangular `L`, full and column-major.
