@@ -8,7 +8,7 @@ use crate::contact::{ActiveContact, ContactError, ContactSet};
 use crate::linalg::{CholeskyError, LowRankCorrection, SparseColumn};
 use crate::linkage::body_state::{fill_tangent, internal_force_vector, norm};
 use crate::linkage::line_search::backtrack;
-use crate::linkage::{Convergence, PhaseTimes, SolverUsed, StiffnessAssembly};
+use crate::linkage::{Body, Convergence, PhaseTimes, SolverUsed, StiffnessAssembly};
 use crate::Real;
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -81,16 +81,20 @@ impl CoupledSolver {
         Ok(())
     }
 
-    /// [`CoupledSolver::rebuild`] after a body's DOFs changed (a piece of it removed): the
-    /// entries between bodies, in the old numbering, are dropped and found again as contacts
-    /// need them. `false` when a body is solved iteratively (its solver cannot be rebuilt).
-    pub(crate) fn rebuild_renumbered(&mut self, parts: &[BodyPart]) -> Result<bool, ContactError> {
-        if self.iterative.is_some() {
-            return Ok(false);
+    /// [`CoupledSolver::rebuild`] after body `b`'s DOFs changed (a piece of it removed, or
+    /// given back; `body` as it is now): the entries between bodies, in the old numbering, are
+    /// dropped and found again as contacts need them; with conjugate gradients, the body's
+    /// block preconditioner is built anew for its new rows.
+    pub(crate) fn rebuild_renumbered(
+        &mut self,
+        parts: &[BodyPart],
+        (b, body): (usize, &Body),
+    ) -> Result<(), ContactError> {
+        if let Some(iterative) = self.iterative.as_mut() {
+            iterative.renumber(b, body, &parts[b].dofs, &parts[b].assembly);
         }
         self.coupling.clear();
-        self.rebuild(parts)?;
-        Ok(true)
+        self.rebuild(parts)
     }
 
     /// Conjugate-gradient iterations so far (0 when every body is solved directly).

@@ -139,6 +139,23 @@ impl CoupledIterative {
         })
     }
 
+    /// Body `b`'s free DOFs changed (a piece of it removed, or given back): its rows' nodes
+    /// and rigid-body rows anew from `body`, `dofs` and `assembly`; the coupled matrix and
+    /// every block are built again at the next solve.
+    pub(crate) fn renumber(
+        &mut self,
+        b: usize,
+        body: &Body,
+        dofs: &DofMap,
+        assembly: &StiffnessAssembly,
+    ) {
+        self.groups[b] = assembly.groups.clone();
+        self.near_null_space[b] = rigid_body_rows(&body.nodes, dofs);
+        self.matrix = None;
+        self.blocks.clear();
+        self.built_for = None;
+    }
+
     /// Solve `K δ = r` for the values now in `system` (filled for the contact set `set`), to
     /// `min(tolerance, settings) · max(‖r‖, reference)` with `reference` the force scale (N).
     /// `None` when conjugate gradients do not get there (the caller factors directly).

@@ -387,9 +387,7 @@ impl ContactFracture {
         } else {
             solver.removed[b] = self.fallen[b].clone();
         }
-        if !refit_body(solver, b, &self.bodies[b])? {
-            return Ok(false);
-        }
+        refit_body(solver, b, &self.bodies[b])?;
         fallen.extend(
             pieces
                 .into_iter()
@@ -523,14 +521,14 @@ impl ContactFracture {
 }
 
 /// Give the solver body `b`'s supports anew (nodes removed or given back): its DOF map, its
-/// stiffness pattern and the coupled system. `false` when the coupled system cannot be rebuilt
-/// (a body solved iteratively).
-fn refit_body(solver: &mut ContactSolver, b: usize, body: &Body) -> Result<bool, ContactError> {
+/// stiffness pattern and the coupled system (with conjugate gradients: the body's block
+/// preconditioner too).
+fn refit_body(solver: &mut ContactSolver, b: usize, body: &Body) -> Result<(), ContactError> {
     let dofs = DofMap::new(body);
     let assembly = StiffnessAssembly::new(body, &dofs).map_err(SolveError::from)?;
     let part = &mut solver.parts[b];
     part.dofs = dofs;
     part.assembly = assembly;
     part.local.clear();
-    solver.coupled.rebuild_renumbered(&solver.parts)
+    solver.coupled.rebuild_renumbered(&solver.parts, (b, body))
 }
