@@ -448,3 +448,17 @@ pub(crate) fn closing(
         parts[body].penalty,
     ))
 }
+
+impl SelfContact {
+    /// Classify member `member` of body `b`, broken since the last [`SelfContact::record`],
+    /// as broken in tension (`apart`: its crack closes) or crushed, from how it broke rather
+    /// than from where its ends are at the next recorded state (a body solved without contact
+    /// is recorded at step ends only, and a crack may have opened and closed within a step).
+    pub(crate) fn mark_broken(&mut self, b: usize, member: usize, apart: bool) {
+        if let Some(Some(own)) = self.bodies.get_mut(b) {
+            if let Some(slot) = own.broken.get_mut(member) {
+                slot.get_or_insert(apart);
+            }
+        }
+    }
+}

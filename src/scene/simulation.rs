@@ -1,7 +1,9 @@
 //! One load step of a world: every body solved (alone, or all together with their contacts)
 //! and the step's result and summary line.
 
-use crate::contact::{ContactFracture, ContactSolver, FractureStop, NodeContact};
+use crate::contact::{
+    self_contact_on, ContactFracture, ContactSolver, FractureStop, NodeContact, SelfContactWatch,
+};
 use crate::linkage::fracture::{breaks_members, BreakEvent, FractureState};
 use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
 use crate::scene::instability::InstabilityWatch;
@@ -33,6 +35,9 @@ pub struct Simulation<'w> {
     watch: InstabilityWatch,
     /// Breaking members in a scene with contact: the bodies as they break.
     fracture: Option<ContactFracture>,
+    /// Per body, in a scene solved body by body, the watch for its self-contact (breaking
+    /// bodies with self-contact on); empty once on the contact solver.
+    self_watch: Vec<Option<SelfContactWatch>>,
 }
 
 impl<'w> Simulation<'w> {
@@ -96,11 +101,17 @@ impl<'w> Simulation<'w> {
         } else {
             None
         };
+        let self_watch = if world.has_contact() {
+            Vec::new()
+        } else {
+            self_watches(world)
+        };
         Ok(Simulation {
             world,
             solver,
             watch: InstabilityWatch::default(),
             fracture,
+            self_watch,
         })
     }
 
@@ -114,85 +125,26 @@ impl<'w> Simulation<'w> {
 
     /// The result of `step` (0..=steps) and its summary line (without the time). Steps are
     /// meant to come in order; asking for an earlier one starts the nonlinear solvers over.
+    ///
+    /// A scene solved body by body whose breaking body touches itself at the end of a step
+    /// (see [`SelfContactWatch`]) goes on with the contact solver from that step: the steps
+    /// before it are solved again with contact (nothing touched in them, so their state is the
+    /// same) to bring the contact solver to the step's start, and the step is solved with it.
     pub fn step(&mut self, step: usize) -> Result<(StepResult, StepSummary), RunError> {
         let world = self.world;
         let mut summary = empty_summary(step, world.load_factor(step));
         // Per body its state and, with contact, the nodes pressing on something.
-        let (states, contacts): (Vec<StepState>, Vec<Vec<NodeContact>>) = match &mut self.solver {
-            WorldSolver::Contact(contact) => {
-                let contact_error = |source| RunError::Contact {
-                    scene: world.source.clone(),
-                    source,
-                };
-                let (solved, fractures) = match self.fracture.as_mut() {
-                    None => (
-                        contact
-                            .solve_step(&world.bodies, &world.obstacles, step, world.steps)
-                            .map_err(contact_error)?,
-                        Vec::new(),
-                    ),
-                    Some(fr) => match fr.solve_step(contact, &world.obstacles, step, world.steps) {
-                        Ok(solved) => solved,
-                        Err(FractureStop::Contact(e)) => return Err(contact_error(e)),
-                        Err(FractureStop::Collapse {
-                            body,
-                            member,
-                            breaks,
-                        }) => {
-                            let name = &world.bodies[body].name;
-                            return Err(self.collapse(name, step, member, &breaks));
-                        }
-                    },
-                };
-                let mut solved = solved;
-                for (state, f) in solved.states.iter_mut().zip(fractures) {
-                    state.fracture = f;
+        let (states, contacts) = if matches!(self.solver, WorldSolver::Contact(_)) {
+            self.solve_with_contact(step, &mut summary)?
+        } else {
+            match self.solve_bodies(step, &mut summary)? {
+                Ok(states) => (states, Vec::new()),
+                Err(touch) => {
+                    self.switch_to_contact(step)?;
+                    summary = empty_summary(step, world.load_factor(step));
+                    summary.warnings.push(touch);
+                    self.solve_with_contact(step, &mut summary)?
                 }
-                summary.iterations = solved.newton_iterations;
-                summary.cuts = solved.cuts;
-                summary.negative_pivots = solved.negative_pivots;
-                summary.linear_iterations = solved.linear_iterations;
-                summary.contact_iterations = solved.contact_iterations;
-                summary.sticking = solved.sticking;
-                summary.slipping = solved.slipping;
-                summary.max_penetration = solved.max_penetration;
-                summary.warnings = solved.warnings;
-                for (body, totals) in world.bodies.iter().zip(&solved.totals) {
-                    let d = body.dimension.dofs_per_node();
-                    for (with, force) in totals {
-                        summary.contact_forces.push(PairForce {
-                            body: body.name.clone(),
-                            with: with.clone(),
-                            force: force.as_slice()[..d].to_vec(),
-                        });
-                    }
-                }
-                (solved.states, solved.contacts)
-            }
-            WorldSolver::Bodies(solvers) => {
-                let mut states = Vec::with_capacity(solvers.len());
-                for (body, solver) in world.bodies.iter().zip(solvers.iter_mut()) {
-                    let state = match solver.solve_step(body, step, world.steps) {
-                        Ok(state) => state,
-                        Err(SolveError::Collapse {
-                            body,
-                            step,
-                            member,
-                            breaks,
-                        }) => {
-                            return Err(self.collapse(&body, step, member, &breaks));
-                        }
-                        Err(source) => {
-                            return Err(RunError::Solve {
-                                scene: world.source.clone(),
-                                source,
-                            })
-                        }
-                    };
-                    add_newton_counts(&mut summary, &state);
-                    states.push(state);
-                }
-                (states, Vec::new())
             }
         };
         let mut result = StepResult {
@@ -237,6 +189,163 @@ impl<'w> Simulation<'w> {
             .warnings(&world.bodies, step, &states, &summary.contact_forces);
         summary.warnings.extend(warnings);
         Ok((result, summary))
+    }
+
+    /// Solve `step` with the contact solver (breaking members event by event when a body
+    /// breaks): per body its state and its contacts; the step's counts go into `summary`.
+    #[allow(clippy::type_complexity)]
+    fn solve_with_contact(
+        &mut self,
+        step: usize,
+        summary: &mut StepSummary,
+    ) -> Result<(Vec<StepState>, Vec<Vec<NodeContact>>), RunError> {
+        let world = self.world;
+        let WorldSolver::Contact(contact) = &mut self.solver else {
+            return Ok((Vec::new(), Vec::new()));
+        };
+        let contact_error = |source| RunError::Contact {
+            scene: world.source.clone(),
+            source,
+        };
+        let (solved, fractures) = match self.fracture.as_mut() {
+            None => (
+                contact
+                    .solve_step(&world.bodies, &world.obstacles, step, world.steps)
+                    .map_err(contact_error)?,
+                Vec::new(),
+            ),
+            Some(fr) => match fr.solve_step(contact, &world.obstacles, step, world.steps) {
+                Ok(solved) => solved,
+                Err(FractureStop::Contact(e)) => return Err(contact_error(e)),
+                Err(FractureStop::Collapse {
+                    body,
+                    member,
+                    breaks,
+                }) => {
+                    let name = &world.bodies[body].name;
+                    return Err(self.collapse(name, step, member, &breaks));
+                }
+            },
+        };
+        let mut solved = solved;
+        for (state, f) in solved.states.iter_mut().zip(fractures) {
+            state.fracture = f;
+        }
+        summary.iterations = solved.newton_iterations;
+        summary.cuts = solved.cuts;
+        summary.negative_pivots = solved.negative_pivots;
+        summary.linear_iterations = solved.linear_iterations;
+        summary.contact_iterations = solved.contact_iterations;
+        summary.sticking = solved.sticking;
+        summary.slipping = solved.slipping;
+        summary.max_penetration = solved.max_penetration;
+        summary.warnings.append(&mut solved.warnings);
+        for (body, totals) in world.bodies.iter().zip(&solved.totals) {
+            let d = body.dimension.dofs_per_node();
+            for (with, force) in totals {
+                summary.contact_forces.push(PairForce {
+                    body: body.name.clone(),
+                    with: with.clone(),
+                    force: force.as_slice()[..d].to_vec(),
+                });
+            }
+        }
+        Ok((solved.states, solved.contacts))
+    }
+
+    /// Solve `step` body by body: per body its state (`Ok`), or, when a breaking body touches
+    /// itself at the end of the step, `Err` with the warning that says so (nothing kept).
+    #[allow(clippy::type_complexity)]
+    fn solve_bodies(
+        &mut self,
+        step: usize,
+        summary: &mut StepSummary,
+    ) -> Result<Result<Vec<StepState>, String>, RunError> {
+        let world = self.world;
+        let WorldSolver::Bodies(solvers) = &mut self.solver else {
+            return Ok(Ok(Vec::new()));
+        };
+        let mut states = Vec::with_capacity(solvers.len());
+        for (body, solver) in world.bodies.iter().zip(solvers.iter_mut()) {
+            let state = match solver.solve_step(body, step, world.steps) {
+                Ok(state) => state,
+                Err(SolveError::Collapse {
+                    body,
+                    step,
+                    member,
+                    breaks,
+                }) => {
+                    return Err(self.collapse(&body, step, member, &breaks));
+                }
+                Err(source) => {
+                    return Err(RunError::Solve {
+                        scene: world.source.clone(),
+                        source,
+                    })
+                }
+            };
+            add_newton_counts(summary, &state);
+            states.push(state);
+        }
+        for (b, state) in states.iter().enumerate() {
+            let Some(watch) = self.self_watch.get_mut(b).and_then(Option::as_mut) else {
+                continue;
+            };
+            let body = &world.bodies[b];
+            if step == 0 {
+                // A run started over: the watch starts at rest too.
+                *watch = SelfContactWatch::new(body).map_err(|source| RunError::Contact {
+                    scene: world.source.clone(),
+                    source,
+                })?;
+            }
+            let d = body.dimension.dofs_per_node();
+            let u: Vec<Real> = state
+                .displacements
+                .iter()
+                .flat_map(|v| v.iter().take(d).copied().collect::<Vec<_>>())
+                .collect();
+            let Some(fracture) = &state.fracture else {
+                continue;
+            };
+            let tension = |m: usize| match &solvers[b] {
+                BodySolver::Breaking(eq) => eq.broke_in_tension(m),
+                _ => false,
+            };
+            let fallen = fracture.fallen.iter().flat_map(|p| p.nodes.iter().copied());
+            if let Some(touch) = watch.check(&u, &fracture.broken, tension, fallen) {
+                return Ok(Err(format!(
+                    "body '{}' touches itself at step {step} (node {}: {}): the scene is solved with contact from this step on (steps 0 to {} solved again with it)",
+                    body.name,
+                    touch.node + 1,
+                    touch.what,
+                    step.saturating_sub(1)
+                )));
+            }
+        }
+        Ok(Ok(states))
+    }
+
+    /// Put the world on the contact solver and bring it to the start of `step`: steps 0 to
+    /// `step − 1` solved again with contact (their results are those already written).
+    fn switch_to_contact(&mut self, step: usize) -> Result<(), RunError> {
+        let world = self.world;
+        let contact = ContactSolver::new(&world.bodies, &world.obstacles, world.contact.clone())
+            .map_err(|source| RunError::Contact {
+                scene: world.source.clone(),
+                source,
+            })?;
+        self.solver = WorldSolver::Contact(Box::new(contact));
+        self.fracture = ContactFracture::new(&world.bodies).map_err(|source| RunError::Solve {
+            scene: world.source.clone(),
+            source,
+        })?;
+        self.self_watch.clear();
+        for s in 0..step {
+            let mut replay = empty_summary(s, world.load_factor(s));
+            self.solve_with_contact(s, &mut replay)?;
+        }
+        Ok(())
     }
 
     /// The collapse of body `body` at `step` by breaking `member` (0-based), `breaks` the
@@ -339,6 +448,28 @@ impl<'w> Simulation<'w> {
             }
         }
     }
+}
+
+/// Per body of a world solved body by body, the watch for its self-contact: breaking bodies
+/// with self-contact on (see [`self_contact_on`]), when the world can go on with the contact
+/// solver (no pressure loads: the contact solver does not take them) and its surface is one the
+/// contact detection takes.
+fn self_watches(world: &World) -> Vec<Option<SelfContactWatch>> {
+    if world.bodies.iter().any(|b| !b.pressures.is_empty()) {
+        return Vec::new();
+    }
+    world
+        .bodies
+        .iter()
+        .map(|body| {
+            if !(breaks_members(body) && self_contact_on(body, world.contact.self_contact)) {
+                return None;
+            }
+            // A surface the contact detection refuses (patches that disagree) would refuse the
+            // contact solver too: such a body is solved as before, without the watch.
+            SelfContactWatch::new(body).ok()
+        })
+        .collect()
 }
 
 /// The summary line of `step` before anything is solved.

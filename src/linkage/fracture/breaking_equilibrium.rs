@@ -89,6 +89,8 @@ pub struct BreakingEquilibrium {
     patterns: Vec<LoadPattern>,
     /// Members broken so far, in order.
     broken: Vec<usize>,
+    /// Per member, whether it broke in tension (its ends apart at the break).
+    in_tension: Vec<bool>,
     /// Per node, whether it fell off with a piece.
     fallen_node: Vec<bool>,
     supported_node: Vec<bool>,
@@ -144,6 +146,7 @@ impl BreakingEquilibrium {
             limits,
             patterns: Vec::new(),
             broken: Vec::new(),
+            in_tension: vec![false; body.members.len()],
             fallen_node: vec![false; body.nodes.len()],
             supported_node,
         };
@@ -182,6 +185,12 @@ impl BreakingEquilibrium {
     /// Members broken so far, 0-based, in order.
     pub fn broken(&self) -> &[usize] {
         &self.broken
+    }
+
+    /// Whether member `m` broke in tension (its ends apart at the break, so that its crack
+    /// can close again); `false` for a member crushed, or not broken.
+    pub fn broke_in_tension(&self, m: usize) -> bool {
+        self.in_tension.get(m).copied().unwrap_or(false)
     }
 
     /// Fill `K_ff` with the intact members; a free DOF of a node left without members is held
@@ -496,6 +505,15 @@ impl BreakingEquilibrium {
         let Some(mut event) = self.next_break(body, &f0, &f1) else {
             return Ok(None);
         };
+        // The member's elongation at the break, before its removal changes the patterns.
+        let t = event.fraction;
+        let elongation: Real = self
+            .elongations(body, event.member)
+            .iter()
+            .zip(f0.iter().zip(&f1))
+            .map(|(e, (a, b))| e * (a + t * (b - a)))
+            .sum();
+        self.in_tension[event.member] = elongation > 0.0;
         match self.break_member(body, event.member) {
             Ok((tooth, pieces)) => {
                 fallen.extend(pieces);
