@@ -342,3 +342,142 @@ fn self_of_the_wrong_type_is_a_clear_error() {
     let err = format!("{:#}", load_scene(&scene).unwrap_err());
     assert!(err.contains("c.toml") && err.contains("self"), "{err}");
 }
+
+/// A U of crossed square cells (side 0.1 m, mirror-symmetric about x = 0): a base 8 cells wide
+/// and 2 high, two arms 2 cells wide and 6 high, 0.4 m apart; the base's bottom held, the 3
+/// top nodes of each arm pushed inward by 1500 N each over 4 steps (an arm alone would pass the
+/// middle). Its material breaks, at a strength no member reaches. `contact` is the scene's
+/// `[contact]` table (empty: none).
+fn u_scene(dir: &Path, contact: &str) -> std::path::PathBuf {
+    let mut keys: Vec<(i32, i32)> = Vec::new();
+    let mut links: Vec<(usize, usize)> = Vec::new();
+    let mut id = |k: (i32, i32)| -> usize {
+        match keys.iter().position(|&q| q == k) {
+            Some(i) => i + 1,
+            None => {
+                keys.push(k);
+                keys.len()
+            }
+        }
+    };
+    let mut cells: Vec<(i32, i32)> = (0..8).flat_map(|c| (0..2).map(move |r| (c, r))).collect();
+    cells.extend((2..8).flat_map(|r| [0, 1, 6, 7].map(|c| (c, r))));
+    for (c, r) in cells {
+        let (a, b, cc, d) = (
+            id((c, r)),
+            id((c + 1, r)),
+            id((c + 1, r + 1)),
+            id((c, r + 1)),
+        );
+        for (p, q) in [(a, b), (b, cc), (d, cc), (a, d), (a, cc), (b, d)] {
+            let key = (p.min(q), p.max(q));
+            if !links.contains(&key) {
+                links.push(key);
+            }
+        }
+    }
+    let p: Vec<[f64; 2]> = keys
+        .iter()
+        .map(|&(c, r)| [-0.4 + c as f64 * 0.1, r as f64 * 0.1])
+        .collect();
+    let pick = |f: &dyn Fn(&[f64; 2]) -> bool| -> String {
+        let list: Vec<String> = (0..p.len())
+            .filter(|&i| f(&p[i]))
+            .map(|i| (i + 1).to_string())
+            .collect();
+        list.join(", ")
+    };
+    let bottom = pick(&|q| q[1].abs() < 1e-9);
+    let left = pick(&|q| (q[1] - 0.8).abs() < 1e-9 && q[0] < 0.0);
+    let right = pick(&|q| (q[1] - 0.8).abs() < 1e-9 && q[0] > 0.0);
+    let nodes: String = p.iter().map(|q| format!("{} {}\n", q[0], q[1])).collect();
+    let links: String = links.iter().map(|(a, b)| format!("{a} {b}\n")).collect();
+    std::fs::write(dir.join("u.nodes"), nodes).unwrap();
+    std::fs::write(dir.join("u.links"), links).unwrap();
+    let scene = dir.join("u.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "u"
+steps = 4
+[[materials]]
+name = "m"
+youngs_modulus = 1e9
+area = 1e-4
+strength = 1e15
+failure = "break"
+[[bodies]]
+name = "u"
+nodes = "u.nodes"
+links = "u.links"
+material = "m"
+[[bodies.supports]]
+nodes = [{bottom}]
+fix = ["x", "y"]
+[[bodies.loads]]
+nodes = [{left}]
+force = [1500.0, 0.0]
+[[bodies.loads]]
+nodes = [{right}]
+force = [-1500.0, 0.0]
+{contact}
+"#
+        ),
+    )
+    .unwrap();
+    scene
+}
+
+/// The arms of a breaking U (no member breaks) pushed onto each other, in a scene without
+/// `[contact]`: its own surface holds them (the surface rule, not a crack). Up to the step at
+/// whose end they first touch it is solved by the body solver, and matches the contact
+/// solver's answer of the same scene with `[contact] self = true` (1e-9 of the largest
+/// displacement); from that step on it is solved with contact, the steps before solved again
+/// to reach its start, so its step files are byte-identical to that scene's.
+#[test]
+fn a_breaking_body_folded_onto_its_own_surface_goes_on_with_contact() {
+    let dir = tempfile::tempdir().unwrap();
+    let runs: Vec<(std::path::PathBuf, Summary)> = ["", "[contact]\nself = true"]
+        .iter()
+        .enumerate()
+        .map(|(k, contact)| {
+            let d = dir.path().join(k.to_string());
+            std::fs::create_dir_all(&d).unwrap();
+            let scene = u_scene(&d, contact);
+            let out = d.join("out");
+            let summary = run(&load_scene(&scene).unwrap(), &out, &|| {}).expect("a result");
+            (out, summary)
+        })
+        .collect();
+    let (watched, contact) = (&runs[0], &runs[1]);
+    assert!(watched.1.breaks.is_empty());
+    let from = switched(&watched.1);
+    assert_eq!(from.len(), 1, "{:?}", watched.1.steps);
+    let from = from[0];
+    assert!(from >= 1);
+    let last = step_file(&contact.0, "u", 4);
+    assert!(!last["bodies"][0]["contacts"].as_array().unwrap().is_empty());
+    for s in 0..=4 {
+        let read = |out: &Path| std::fs::read(out.join(format!("u/steps/{s:04}.json"))).unwrap();
+        if s >= from {
+            assert!(read(&watched.0) == read(&contact.0), "step {s} differs");
+            continue;
+        }
+        let displacements = |out: &Path| -> Vec<f64> {
+            step_file(out, "u", s)["bodies"][0]["displacements"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(vector)
+                .collect()
+        };
+        let (a, b) = (displacements(&watched.0), displacements(&contact.0));
+        let umax = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (x, y) in a.iter().zip(&b) {
+            assert!(
+                (x - y).abs() <= 1e-9 * umax.max(1e-300),
+                "step {s}: {x} vs {y}"
+            );
+        }
+    }
+}
