@@ -15,7 +15,7 @@ use crate::contact::settle::BodyPart;
 use crate::contact::{
     default_penalty, penetration_tolerance, ContactError, ContactSet, Penalty, Target,
 };
-use crate::linkage::{Body, DofMap, SolveError, StiffnessAssembly};
+use crate::linkage::{Body, DofMap, StiffnessAssembly};
 use crate::Real;
 
 /// A self-contact found by the watch: the first one, for the message.
@@ -37,6 +37,8 @@ pub struct SelfContactWatch {
     broken: Vec<bool>,
     /// Nodes of pieces that fell off.
     fallen: Vec<bool>,
+    /// Steps checked so far.
+    pub checked: usize,
 }
 
 impl SelfContactWatch {
@@ -44,8 +46,9 @@ impl SelfContactWatch {
     pub fn new(body: &Body) -> Result<Self, ContactError> {
         let bodies = vec![body.clone()];
         let geometry = Geometry::new(&bodies, &[], None)?;
+        // Detection reads the displacements, DOF map, penalty and tolerance only: no pattern.
         let dofs = DofMap::new(body);
-        let assembly = StiffnessAssembly::new(body, &dofs).map_err(SolveError::from)?;
+        let assembly = StiffnessAssembly::default();
         let parts = vec![BodyPart {
             u: vec![0.0; body.dof_count()],
             penalty: Penalty {
@@ -62,6 +65,7 @@ impl SelfContactWatch {
             body: bodies,
             geometry,
             parts,
+            checked: 0,
         };
         watch.record();
         Ok(watch)
@@ -84,6 +88,7 @@ impl SelfContactWatch {
         in_tension: impl Fn(usize) -> bool,
         fallen: impl IntoIterator<Item = usize>,
     ) -> Option<SelfTouch> {
+        self.checked += 1;
         let body = &mut self.body[0];
         if body.member_factors.len() != body.members.len() {
             body.member_factors = vec![1.0; body.members.len()];

@@ -11,8 +11,9 @@ const NOT_FREE: u32 = u32::MAX;
 /// The sparse pattern of `K_ff` (lower triangle, compressed columns) of one body, computed
 /// once, with the place of every member entry in it, so that refilling the values (paper
 /// Eq. 3–4: adding each member's Eq. 2 matrix into the global one) is a single pass over the
-/// members with no sorting and no allocation.
-#[derive(Clone, Debug)]
+/// members with no sorting and no allocation. The default is the empty pattern (no free DOF,
+/// no member): a placeholder where no matrix is assembled.
+#[derive(Clone, Debug, Default)]
 pub struct StiffnessAssembly {
     /// Number of free DOFs (rows and columns of `K_ff`).
     pub n: usize,

@@ -292,7 +292,7 @@ impl<'w> Simulation<'w> {
                 continue;
             };
             let body = &world.bodies[b];
-            if step == 0 {
+            if step == 0 && watch.checked > 0 {
                 // A run started over: the watch starts at rest too.
                 *watch = SelfContactWatch::new(body).map_err(|source| RunError::Contact {
                     scene: world.source.clone(),
