@@ -310,17 +310,23 @@ impl SparseCholesky {
         let mem = MemBuffer::try_new(req).map_err(|_| {
             CholeskyError::Resources(format!("workspace of {} bytes", req.size_bytes()))
         })?;
-        let l_values = zeroed(symbolic.len_val())?;
-        let tree = match (symbolic.raw(), par) {
-            (SymbolicCholeskyRaw::Supernodal(s), Par::Rayon(t)) if tree_parallel && t.get() > 1 => {
-                let mut inv = vec![0; n];
-                for (new, &old) in perm.iter().enumerate() {
-                    inv[old] = new;
+        // The factor's first touch (page faults) and the tree plan side by side.
+        let (l_values, tree) = rayon::join(
+            || zeroed(symbolic.len_val()),
+            || match (symbolic.raw(), par) {
+                (SymbolicCholeskyRaw::Supernodal(s), Par::Rayon(t))
+                    if tree_parallel && t.get() > 1 =>
+                {
+                    let mut inv = vec![0; n];
+                    for (new, &old) in perm.iter().enumerate() {
+                        inv[old] = new;
+                    }
+                    TreePlan::new(s, col_ptr, row_idx, &inv)
                 }
-                TreePlan::new(s, col_ptr, row_idx, &inv)
-            }
-            _ => None,
-        };
+                _ => None,
+            },
+        );
+        let l_values = l_values?;
 
         Ok(Self {
             n,

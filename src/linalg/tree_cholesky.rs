@@ -16,6 +16,7 @@
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch, LltError};
 use faer::linalg::matmul::matmul;
+use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
@@ -28,6 +29,10 @@ pub(crate) const MIN_TREE_WORK: f64 = 2e8;
 
 /// Narrowest column block of a supernode whose updates are shared between threads.
 const MIN_BLOCK_COLUMNS: usize = 16;
+
+/// Fewest columns of an update product whose square part is formed as a lower triangle only
+/// (below it the full square costs less than the triangular product's blocking).
+const MIN_TRIANGULAR_PRODUCT: usize = 16;
 
 /// Fewest DOFs for which [`postorder`] is applied to a nested-dissection ordering, so that
 /// the tree plan can be used; smaller bodies keep their ordering (and their exact results).
@@ -537,12 +542,46 @@ impl TreePlan {
                 dw,
             );
             let below = dpat.len() - p0;
-            let bot = ld.subrows(dw + p0, below);
             let top = ld.subrows(dw + p0, mid);
             work.product.resize(below * mid, 0.0);
             let prod =
                 MatMut::from_column_major_slice_mut(&mut work.product[..below * mid], below, mid);
-            matmul(prod, Accum::Replace, bot, top.transpose(), 1.0, Par::Seq);
+            let (prod_top, prod_bot) = prod.split_at_row_mut(mid);
+            // Only the lower triangle of the square part is scattered: computing just it
+            // halves the work where a separator's rows fall in this block.
+            if mid >= MIN_TRIANGULAR_PRODUCT {
+                triangular::matmul(
+                    prod_top,
+                    BlockStructure::TriangularLower,
+                    Accum::Replace,
+                    top,
+                    BlockStructure::Rectangular,
+                    top.transpose(),
+                    BlockStructure::Rectangular,
+                    1.0,
+                    Par::Seq,
+                );
+            } else {
+                matmul(
+                    prod_top,
+                    Accum::Replace,
+                    top,
+                    top.transpose(),
+                    1.0,
+                    Par::Seq,
+                );
+            }
+            if below > mid {
+                let rest = ld.subrows(dw + p0 + mid, below - mid);
+                matmul(
+                    prod_bot,
+                    Accum::Replace,
+                    rest,
+                    top.transpose(),
+                    1.0,
+                    Par::Seq,
+                );
+            }
             // Rows of the product in `k`'s block, then each column's lower part scattered.
             let rows_d = &dpat[p0..];
             work.target.clear();
