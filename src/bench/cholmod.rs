@@ -112,13 +112,21 @@ impl DirectTiming {
     }
 }
 
-/// Orders, factors and solves `s` with [`SparseCholesky`] and `options`, timing each phase.
-pub fn time_direct(s: &LowerSystem, options: CholeskyOptions) -> Result<DirectTiming, String> {
+/// Orders, factors and solves `s` with [`SparseCholesky`] and `options`, timing each phase;
+/// `tree = false` factors with faer's own supernode loop instead of the tree-parallel one.
+pub fn time_direct(
+    s: &LowerSystem,
+    options: CholeskyOptions,
+    tree: bool,
+) -> Result<DirectTiming, String> {
     let cpu0 = cpu_seconds();
     let t = Instant::now();
     let mut c =
         SparseCholesky::analyze_with(s.n, &s.col_ptr, &s.row_idx, s.groups.as_deref(), options)
             .map_err(|e| e.to_string())?;
+    if !tree {
+        c.disable_tree_parallel();
+    }
     let analyze = t.elapsed().as_secs_f64();
     let t = Instant::now();
     c.factorize(&s.values).map_err(|e| e.to_string())?;
@@ -190,7 +198,7 @@ mod tests {
     #[test]
     fn direct_solve_of_a_small_lattice_has_a_tiny_residual() {
         let (s, _) = lattice_system([3, 3, 3]).unwrap();
-        let t = time_direct(&s, CholeskyOptions::default()).unwrap();
+        let t = time_direct(&s, CholeskyOptions::default(), true).unwrap();
         assert!(t.residual < 1e-12, "residual {}", t.residual);
         assert!(t.nnz_l >= s.row_idx.len());
         // A wrong answer gives a residual of order one.

@@ -18,6 +18,7 @@ use super::ordering::{
     expand_to_dofs, graph_of_pattern, nested_dissection, nested_dissection_with_trailing,
     OrderingError,
 };
+use super::tree_cholesky::{postorder, TreePlan, MIN_TREE_DOFS};
 
 /// Default smallest accepted pivot ratio `d_j / A_jj` (dimensionless): below it the
 /// matrix is treated as singular to working precision.
@@ -151,6 +152,8 @@ pub struct SparseCholesky {
     /// Workspace for both the numeric factorization and the solve.
     mem: MemBuffer,
     par: Par,
+    /// Factor independent subtrees side by side (large supernodal factors on several threads).
+    tree: Option<TreePlan>,
     pivot_tolerance: f64,
     ordering: FillOrdering,
     factorized: bool,
@@ -200,14 +203,23 @@ impl SparseCholesky {
             }
         }
 
+        // Large bodies on several threads: postorder, so that the tree plan applies.
+        let tree_parallel = options.ordering == FillOrdering::NestedDissection
+            && options.threads != 1
+            && n >= MIN_TREE_DOFS;
         let custom = match options.ordering {
             FillOrdering::NestedDissection => {
                 let n_nodes = groups.map_or(n, |g| g.iter().max().map_or(0, |&m| m + 1));
                 let (xadj, adjncy) = graph_of_pattern(n, col_ptr, row_idx, groups, n_nodes)?;
                 let (node_perm, node_inv) = nested_dissection(&xadj, &adjncy)?;
-                Some(match groups {
+                let (perm, inv) = match groups {
                     Some(g) => expand_to_dofs(&node_perm, g)?,
                     None => (node_perm, node_inv),
+                };
+                Some(if tree_parallel {
+                    postorder(col_ptr, row_idx, &perm, &inv)
+                } else {
+                    (perm, inv)
                 })
             }
             // faer 0.24's `SymmetricOrdering::Identity` skips the conversion to the upper
@@ -217,7 +229,7 @@ impl SparseCholesky {
             FillOrdering::Identity => Some(((0..n).collect(), (0..n).collect())),
             FillOrdering::Amd => None,
         };
-        Self::analyze_ordered(n, col_ptr, row_idx, custom, options)
+        Self::analyze_ordered(n, col_ptr, row_idx, custom, options, tree_parallel)
     }
 
     /// Symbolic analysis with the DOFs of the nodes marked `trailing` (`trailing[node]`,
@@ -248,16 +260,18 @@ impl SparseCholesky {
             layout: FactorLayout::Supernodal,
             threads,
         };
-        Self::analyze_ordered(n, col_ptr, row_idx, custom, options)
+        Self::analyze_ordered(n, col_ptr, row_idx, custom, options, false)
     }
 
-    /// The symbolic analysis proper, with `custom = Some((perm, inv))` or AMD.
+    /// The symbolic analysis proper, with `custom = Some((perm, inv))` or AMD;
+    /// `tree_parallel`: the ordering was postordered for the tree-parallel factorization.
     fn analyze_ordered(
         n: usize,
         col_ptr: &[usize],
         row_idx: &[usize],
         custom: Option<(Vec<usize>, Vec<usize>)>,
         options: CholeskyOptions,
+        tree_parallel: bool,
     ) -> Result<Self, CholeskyError> {
         let ordering = match &custom {
             Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
@@ -296,7 +310,23 @@ impl SparseCholesky {
         let mem = MemBuffer::try_new(req).map_err(|_| {
             CholeskyError::Resources(format!("workspace of {} bytes", req.size_bytes()))
         })?;
-        let l_values = zeroed(symbolic.len_val())?;
+        // The factor's first touch (page faults) and the tree plan side by side.
+        let (l_values, tree) = rayon::join(
+            || zeroed(symbolic.len_val()),
+            || match (symbolic.raw(), par) {
+                (SymbolicCholeskyRaw::Supernodal(s), Par::Rayon(t))
+                    if tree_parallel && t.get() > 1 =>
+                {
+                    let mut inv = vec![0; n];
+                    for (new, &old) in perm.iter().enumerate() {
+                        inv[old] = new;
+                    }
+                    TreePlan::new(s, col_ptr, row_idx, &inv)
+                }
+                _ => None,
+            },
+        );
+        let l_values = l_values?;
 
         Ok(Self {
             n,
@@ -308,6 +338,7 @@ impl SparseCholesky {
             l_values,
             mem,
             par,
+            tree,
             pivot_tolerance: DEFAULT_PIVOT_TOLERANCE,
             ordering: options.ordering,
             factorized: false,
@@ -338,6 +369,14 @@ impl SparseCholesky {
                 self.pattern.row_idx()[k]
             )));
         }
+        if let Some(plan) = &self.tree {
+            if let Err(col) = plan.factorize(values, &mut self.l_values, self.par) {
+                return Err(CholeskyError::NonPositivePivot {
+                    dof: self.perm[col.min(self.n - 1)],
+                });
+            }
+            return self.check_pivots(values);
+        }
         let a = SparseColMatRef::new(self.pattern.as_ref(), values);
         let result = self.symbolic.factorize_numeric_llt(
             &mut self.l_values,
@@ -353,7 +392,23 @@ impl SparseCholesky {
                 dof: self.perm[self.failed_column(index)],
             });
         }
+        self.check_pivots(values)
+    }
 
+    /// Whether the tree-parallel factorization is in use (large supernodal factors with
+    /// more than one thread).
+    pub fn is_tree_parallel(&self) -> bool {
+        self.tree.is_some()
+    }
+
+    /// Use faer's own sequential supernode loop from now on (for comparisons).
+    pub fn disable_tree_parallel(&mut self) {
+        self.tree = None;
+        self.factorized = false;
+    }
+
+    /// Rejects a factor with a pivot ratio below the tolerance; marks it usable otherwise.
+    fn check_pivots(&mut self, values: &[f64]) -> Result<(), CholeskyError> {
         // O(n): one pass over the pivots in permuted order.
         let (mut worst, mut worst_at) = (f64::INFINITY, 0);
         for (j, (&lp, &ap)) in self.l_diag.iter().zip(&self.a_diag).enumerate() {

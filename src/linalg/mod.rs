@@ -19,3 +19,4 @@ mod low_rank;
 pub mod multigrid;
 pub mod ordering;
 mod symmetric_csr;
+mod tree_cholesky;

@@ -1,0 +1,687 @@
+//! Numeric supernodal LLᵀ that works on independent subtrees of the elimination tree at once.
+//!
+//! faer 0.24's supernodal factorization visits the supernodes one after another and hands
+//! its parallelism to the dense kernels only, which pays for the large separators at the top
+//! of a nested-dissection tree but leaves one core idle (or spinning at a barrier) through
+//! the many small supernodes below them. Nested dissection makes the two halves of every
+//! separator independent: here subtrees with enough work are factored side by side (rayon),
+//! each with sequential kernels, and the separators above them with faer's parallel kernels.
+//! The factor is written in faer's own storage, so faer's solve reads it unchanged.
+//!
+//! The algorithm is faer's left-looking one: a supernode gathers the updates of the
+//! descendants whose rows meet its columns, then factors its diagonal block and solves for
+//! the rows below it. Only the dense update product is formed apart and subtracted, so the
+//! factor agrees with faer's to rounding (not bit for bit).
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch, LltError};
+use faer::linalg::matmul::matmul;
+use faer::linalg::matmul::triangular::{self, BlockStructure};
+use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
+use faer::{Accum, MatMut, MatRef, Par};
+use rayon::prelude::*;
+
+/// Below this many flops of factorization work the tree plan is not built: faer's own
+/// sequential loop is as fast, and small bodies keep its exact results.
+pub(crate) const MIN_TREE_WORK: f64 = 2e8;
+
+/// Narrowest column block of a supernode whose updates are shared between threads.
+const MIN_BLOCK_COLUMNS: usize = 16;
+
+/// Fewest columns of an update product whose square part is formed as a lower triangle only
+/// (below it the full square costs less than the triangular product's blocking).
+const MIN_TRIANGULAR_PRODUCT: usize = 16;
+
+/// Fewest DOFs for which [`postorder`] is applied to a nested-dissection ordering, so that
+/// the tree plan can be used; smaller bodies keep their ordering (and their exact results).
+pub(crate) const MIN_TREE_DOFS: usize = 20_000;
+
+/// `perm` (`perm[new] = old`) followed by a postorder of the elimination tree of the permuted
+/// matrix (A's lower CSC pattern, original order): the same fill and the same tree, but
+/// every subtree's columns (and so its supernodes) contiguous, which faer's analysis of a
+/// custom ordering does not ensure. Returns `(perm, inv)`.
+pub(crate) fn postorder(
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    perm: &[usize],
+    inv: &[usize],
+) -> (Vec<usize>, Vec<usize>) {
+    let n = perm.len();
+    // Each permuted column's rows above the diagonal.
+    let mut ptr = vec![0usize; n + 1];
+    for j in 0..n {
+        for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+            let (a, b) = (inv[i], inv[j]);
+            if a != b {
+                ptr[a.max(b) + 1] += 1;
+            }
+        }
+    }
+    for k in 0..n {
+        ptr[k + 1] += ptr[k];
+    }
+    let mut next = ptr.clone();
+    let mut upper = vec![0usize; ptr[n]];
+    for j in 0..n {
+        for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+            let (a, b) = (inv[i], inv[j]);
+            if a != b {
+                let (lo, hi) = (a.min(b), a.max(b));
+                upper[next[hi]] = lo;
+                next[hi] += 1;
+            }
+        }
+    }
+    // Liu's elimination tree with path compression.
+    const NONE: usize = usize::MAX;
+    let mut parent = vec![NONE; n];
+    let mut ancestor = vec![NONE; n];
+    for k in 0..n {
+        for &start in &upper[ptr[k]..ptr[k + 1]] {
+            let mut i = start;
+            while ancestor[i] != NONE && ancestor[i] != k {
+                let up = ancestor[i];
+                ancestor[i] = k;
+                i = up;
+            }
+            if ancestor[i] == NONE {
+                ancestor[i] = k;
+                parent[i] = k;
+            }
+        }
+    }
+    // Children in ascending order, then a depth-first postorder from the roots.
+    let mut child_ptr = vec![0usize; n + 1];
+    for &p in &parent {
+        if p != NONE {
+            child_ptr[p + 1] += 1;
+        }
+    }
+    for k in 0..n {
+        child_ptr[k + 1] += child_ptr[k];
+    }
+    let mut fill = child_ptr.clone();
+    let mut child = vec![0usize; child_ptr[n]];
+    for (k, &p) in parent.iter().enumerate() {
+        if p != NONE {
+            child[fill[p]] = k;
+            fill[p] += 1;
+        }
+    }
+    let mut order = Vec::with_capacity(n);
+    let mut stack: Vec<(usize, usize)> = Vec::new();
+    for root in (0..n).filter(|&k| parent[k] == NONE) {
+        stack.push((root, child_ptr[root]));
+        while let Some(top) = stack.last_mut() {
+            let (k, c) = *top;
+            if c < child_ptr[k + 1] {
+                top.1 += 1;
+                stack.push((child[c], child_ptr[child[c]]));
+            } else {
+                order.push(k);
+                stack.pop();
+            }
+        }
+    }
+    let new_perm: Vec<usize> = order.iter().map(|&k| perm[k]).collect();
+    let mut new_inv = vec![0usize; n];
+    for (new, &old) in new_perm.iter().enumerate() {
+        new_inv[old] = new;
+    }
+    (new_perm, new_inv)
+}
+
+/// The supernodal tree and the maps the parallel factorization needs, built once per pattern.
+pub(crate) struct TreePlan {
+    n: usize,
+    /// First column of each supernode, and `n` at the end.
+    begin: Vec<usize>,
+    /// Rows below each supernode's diagonal block: `pattern[pattern_ptr[s]..pattern_ptr[s + 1]]`.
+    pattern_ptr: Vec<usize>,
+    pattern: Vec<usize>,
+    /// Start of each supernode's values in the factor, and the length at the end.
+    val_ptr: Vec<usize>,
+    /// Smallest supernode of each subtree (subtrees are contiguous: postorder).
+    first: Vec<usize>,
+    children_ptr: Vec<usize>,
+    children: Vec<usize>,
+    /// Descendants whose rows meet each supernode's columns, ascending.
+    updaters_ptr: Vec<usize>,
+    updaters: Vec<usize>,
+    /// Flops of each subtree.
+    work: Vec<f64>,
+    roots: Vec<usize>,
+    /// Place in the factor's values of each entry of A (its lower CSC, original order).
+    scatter: Vec<usize>,
+    /// Widest supernode, for the dense Cholesky's workspace.
+    max_width: usize,
+    /// Subtrees with more work than this are split among the threads.
+    split_work: f64,
+}
+
+/// Per-task workspace.
+struct Scratch {
+    /// Row → its place in the current supernode's block.
+    local: Vec<usize>,
+    /// Buffers of the updates.
+    work: UpdateWork,
+    mem: MemBuffer,
+}
+
+impl TreePlan {
+    /// The plan for `s` with A's lower pattern (`col_ptr`, `row_idx`, original order) and
+    /// the permutation `inv[old] = new` of the symbolic analysis. `None` when the supernodes
+    /// are not in postorder or the work is too small to gain from it.
+    pub(crate) fn new(
+        s: &SymbolicSupernodalCholesky<usize>,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        inv: &[usize],
+    ) -> Option<Self> {
+        let n = s.nrows();
+        let ns = s.n_supernodes();
+        let begin: Vec<usize> = s
+            .supernode_begin()
+            .iter()
+            .copied()
+            .chain(std::iter::once(n))
+            .collect();
+        let mut pattern_ptr = Vec::with_capacity(ns + 1);
+        let mut pattern = Vec::new();
+        pattern_ptr.push(0);
+        for k in 0..ns {
+            pattern.extend_from_slice(s.supernode(k).pattern());
+            pattern_ptr.push(pattern.len());
+        }
+        let val_ptr = s.col_ptr_for_val().to_vec();
+        let mut super_of = vec![0usize; n];
+        for k in 0..ns {
+            super_of[begin[k]..begin[k + 1]].fill(k);
+        }
+        let pat = |k: usize| &pattern[pattern_ptr[k]..pattern_ptr[k + 1]];
+
+        // Parents, subtree sizes and postorder check.
+        let parent: Vec<Option<usize>> = (0..ns)
+            .map(|k| pat(k).first().map(|&r| super_of[r]))
+            .collect();
+        let mut first: Vec<usize> = (0..ns).collect();
+        let mut size = vec![1usize; ns];
+        let mut work = vec![0.0; ns];
+        for k in 0..ns {
+            let w = (begin[k + 1] - begin[k]) as f64;
+            let rows = w + pat(k).len() as f64;
+            work[k] += w * rows * rows;
+            if k + 1 != first[k] + size[k] {
+                return None;
+            }
+            if let Some(p) = parent[k] {
+                if p <= k {
+                    return None;
+                }
+                first[p] = first[p].min(first[k]);
+                size[p] += size[k];
+                work[p] += work[k];
+            }
+        }
+        let roots: Vec<usize> = (0..ns).filter(|&k| parent[k].is_none()).collect();
+        let total: f64 = roots.iter().map(|&r| work[r]).sum();
+        if total < MIN_TREE_WORK {
+            return None;
+        }
+        let mut children_ptr = vec![0usize; ns + 1];
+        for p in parent.iter().flatten() {
+            children_ptr[p + 1] += 1;
+        }
+        for k in 0..ns {
+            children_ptr[k + 1] += children_ptr[k];
+        }
+        let mut fill = children_ptr.clone();
+        let mut children = vec![0usize; children_ptr[ns]];
+        for (k, p) in parent.iter().enumerate() {
+            if let Some(p) = *p {
+                children[fill[p]] = k;
+                fill[p] += 1;
+            }
+        }
+
+        // Descendant d updates every supernode its rows fall in.
+        let mut counts = vec![0usize; ns + 1];
+        let mut targets = Vec::new();
+        for d in 0..ns {
+            let mut last = usize::MAX;
+            for &r in pat(d) {
+                let t = super_of[r];
+                if t != last {
+                    targets.push((t, d));
+                    counts[t + 1] += 1;
+                    last = t;
+                }
+            }
+        }
+        for k in 0..ns {
+            counts[k + 1] += counts[k];
+        }
+        let updaters_ptr = counts.clone();
+        let mut updaters = vec![0usize; targets.len()];
+        // `targets` is ordered by d, so each list comes out ascending.
+        for (t, d) in targets {
+            updaters[counts[t]] = d;
+            counts[t] += 1;
+        }
+
+        // Where each entry of A lands in the factor.
+        let mut scatter = Vec::with_capacity(row_idx.len());
+        for j in 0..n {
+            for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                let (a, b) = (inv[i], inv[j]);
+                let (r, c) = if a >= b { (a, b) } else { (b, a) };
+                let k = super_of[c];
+                let w = begin[k + 1] - begin[k];
+                let rows = w + pat(k).len();
+                let local = if r < begin[k + 1] {
+                    r - begin[k]
+                } else {
+                    w + pat(k).binary_search(&r).ok()?
+                };
+                scatter.push(val_ptr[k] + (c - begin[k]) * rows + local);
+            }
+        }
+        let max_width = (0..ns).map(|k| begin[k + 1] - begin[k]).max().unwrap_or(0);
+        Some(TreePlan {
+            n,
+            begin,
+            pattern_ptr,
+            pattern,
+            val_ptr,
+            first,
+            children_ptr,
+            children,
+            updaters_ptr,
+            updaters,
+            work,
+            roots,
+            scatter,
+            max_width,
+            split_work: (total / 64.0).max(1e6),
+        })
+    }
+
+    fn pattern(&self, k: usize) -> &[usize] {
+        &self.pattern[self.pattern_ptr[k]..self.pattern_ptr[k + 1]]
+    }
+
+    fn children(&self, k: usize) -> &[usize] {
+        &self.children[self.children_ptr[k]..self.children_ptr[k + 1]]
+    }
+
+    fn scratch(&self) -> Scratch {
+        Scratch {
+            local: vec![0; self.n],
+            work: UpdateWork::default(),
+            mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(
+                self.max_width,
+                Par::Seq,
+                Default::default(),
+            )),
+        }
+    }
+
+    /// Factors A (`values` in the layout of its lower CSC pattern) into `l` (faer's
+    /// supernodal values). `par`: the kernels' parallelism above the split subtrees. On a
+    /// non-positive pivot returns its column in the permuted order (the smallest such
+    /// column among the subtrees that failed).
+    pub(crate) fn factorize(&self, values: &[f64], l: &mut [f64], par: Par) -> Result<(), usize> {
+        l.par_chunks_mut(1 << 16).for_each(|c| c.fill(0.0));
+        for (&p, &v) in self.scatter.iter().zip(values) {
+            l[p] += v;
+        }
+        // The roots' subtrees tile the supernodes in order.
+        let mut parts = Vec::with_capacity(self.roots.len());
+        let mut rest = l;
+        for &r in &self.roots {
+            let len = self.val_ptr[r + 1] - self.val_ptr[self.first[r]];
+            let (part, tail) = rest.split_at_mut(len);
+            parts.push((r, part));
+            rest = tail;
+        }
+        let threads = match par {
+            Par::Seq => 1,
+            Par::Rayon(t) => t.get(),
+        };
+        if threads > 1 && parts.len() > 1 {
+            let errors: Vec<Result<(), usize>> = parts
+                .into_par_iter()
+                .map(|(r, part)| self.subtree(r, part, &mut self.scratch(), par, true))
+                .collect();
+            errors.into_iter().min_by_key(|e| e.err()).unwrap_or(Ok(()))
+        } else {
+            let mut scratch = self.scratch();
+            for (r, part) in parts {
+                self.subtree(r, part, &mut scratch, par, threads > 1)?;
+            }
+            Ok(())
+        }
+    }
+
+    /// Factors the subtree of `k`, whose values are `l` (from its first supernode on).
+    /// `split`: subtrees may be handed to other threads.
+    fn subtree(
+        &self,
+        k: usize,
+        l: &mut [f64],
+        scratch: &mut Scratch,
+        par: Par,
+        split: bool,
+    ) -> Result<(), usize> {
+        let base = self.val_ptr[self.first[k]];
+        if split && self.work[k] > self.split_work {
+            // A separator split into several supernodes is a chain of single children
+            // (postorder: the only child of `s` is `s - 1`); the independent subtrees start
+            // below the first supernode with more than one child.
+            let mut fork = k;
+            while let [only] = self.children(fork) {
+                fork = *only;
+            }
+            let children = self.children(fork);
+            if children.len() > 1 {
+                let (below, _) = l.split_at_mut(self.val_ptr[fork] - base);
+                let mut parts = Vec::with_capacity(children.len());
+                let mut rest = below;
+                for &c in children {
+                    let len = self.val_ptr[c + 1] - self.val_ptr[self.first[c]];
+                    let (part, tail) = rest.split_at_mut(len);
+                    parts.push((c, part));
+                    rest = tail;
+                }
+                let results: Vec<Result<(), usize>> = parts
+                    .into_par_iter()
+                    .map(|(c, part)| {
+                        let mut own = self.scratch();
+                        self.subtree(c, part, &mut own, Par::Seq, true)
+                    })
+                    .collect();
+                if let Some(e) = results.into_iter().filter_map(Result::err).min() {
+                    return Err(e);
+                }
+                // The chain from the fork up to `k`, each with the shared kernels.
+                for s in fork..=k {
+                    self.supernode(s, l, base, scratch, par)?;
+                }
+                return Ok(());
+            }
+        }
+        let kernels = if split { Par::Seq } else { par };
+        for s in self.first[k]..=k {
+            // Only the separators at the top of an unsplit tree are big enough to share.
+            let p = if s == k { par } else { kernels };
+            self.supernode(s, l, base, scratch, p)?;
+        }
+        Ok(())
+    }
+
+    /// Updates supernode `k` by its descendants, factors its diagonal block and solves for
+    /// its rows below. `l` holds the values from offset `base` up to and including `k`'s.
+    ///
+    /// With several threads (`par`) and a wide supernode, the descendants' updates are
+    /// applied to column blocks of `k` side by side, each block by one thread with
+    /// sequential products: the updates of a separator come from hundreds of small
+    /// descendants, and sharing each small product between threads cost a barrier each.
+    fn supernode(
+        &self,
+        k: usize,
+        l: &mut [f64],
+        base: usize,
+        scratch: &mut Scratch,
+        par: Par,
+    ) -> Result<(), usize> {
+        let (sb, se) = (self.begin[k], self.begin[k + 1]);
+        let w = se - sb;
+        let pat = self.pattern(k);
+        let rows = w + pat.len();
+        for (i, &r) in pat.iter().enumerate() {
+            scratch.local[r] = w + i;
+        }
+        let (head, own) = l.split_at_mut(self.val_ptr[k] - base);
+        let own = &mut own[..self.val_ptr[k + 1] - self.val_ptr[k]];
+        let head = &*head;
+        let updaters = &self.updaters[self.updaters_ptr[k]..self.updaters_ptr[k + 1]];
+        let threads = match par {
+            Par::Seq => 1,
+            Par::Rayon(t) => t.get(),
+        };
+        let blocks = (4 * threads).min(w / MIN_BLOCK_COLUMNS);
+        if threads > 1 && blocks > 1 && !updaters.is_empty() {
+            // Column c holds rows − c entries of the lower triangle; blocks of about equal
+            // entries balance the update work.
+            let total = w * rows - w * (w - 1) / 2;
+            let mut bounds = vec![0];
+            let mut sum = 0;
+            for c in 0..w {
+                sum += rows - c;
+                if sum * blocks >= total * bounds.len() && bounds.len() < blocks {
+                    bounds.push(c + 1);
+                }
+            }
+            if *bounds.last().unwrap_or(&0) != w {
+                bounds.push(w);
+            }
+            let mut parts = Vec::with_capacity(bounds.len());
+            let mut rest = &mut *own;
+            for pair in bounds.windows(2) {
+                let (part, tail) = rest.split_at_mut((pair[1] - pair[0]) * rows);
+                parts.push((pair[0], pair[1], part));
+                rest = tail;
+            }
+            let local = &scratch.local;
+            parts.into_par_iter().for_each(|(c0, c1, part)| {
+                let mut work = UpdateWork::default();
+                self.update_columns(k, head, base, updaters, (c0, c1), local, part, &mut work);
+            });
+        } else {
+            let mut work = std::mem::take(&mut scratch.work);
+            self.update_columns(
+                k,
+                head,
+                base,
+                updaters,
+                (0, w),
+                &scratch.local,
+                own,
+                &mut work,
+            );
+            scratch.work = work;
+        }
+        let ls = MatMut::from_column_major_slice_mut(own, rows, w);
+        let (mut top, bot) = ls.split_at_row_mut(w);
+        match cholesky_in_place(
+            top.rb_mut(),
+            Default::default(),
+            par,
+            MemStack::new(&mut scratch.mem),
+            Default::default(),
+        ) {
+            Ok(_) => {}
+            Err(LltError::NonPositivePivot { index }) => return Err(sb + index),
+        }
+        solve_lower_triangular_in_place(top.rb(), bot.transpose_mut(), par);
+        Ok(())
+    }
+
+    /// Subtracts from columns `c0..c1` of supernode `k` (`part`, column-major with all of
+    /// `k`'s rows) the products of the descendants `updaters` whose rows meet them.
+    /// `head` holds the factor's values from offset `base` up to `k`'s; `local` maps a row
+    /// below `k`'s diagonal block to its place in `k`'s block.
+    #[allow(clippy::too_many_arguments)]
+    fn update_columns(
+        &self,
+        k: usize,
+        head: &[f64],
+        base: usize,
+        updaters: &[usize],
+        (c0, c1): (usize, usize),
+        local: &[usize],
+        part: &mut [f64],
+        work: &mut UpdateWork,
+    ) {
+        let (sb, se) = (self.begin[k], self.begin[k + 1]);
+        let rows = (se - sb) + self.pattern(k).len();
+        let (lo, hi) = (sb + c0, sb + c1);
+        for &d in updaters {
+            let dw = self.begin[d + 1] - self.begin[d];
+            let dpat = self.pattern(d);
+            let p0 = dpat.partition_point(|&r| r < lo);
+            let mid = dpat[p0..].partition_point(|&r| r < hi);
+            if mid == 0 {
+                continue;
+            }
+            let ld = MatRef::from_column_major_slice(
+                &head[self.val_ptr[d] - base..self.val_ptr[d + 1] - base],
+                dw + dpat.len(),
+                dw,
+            );
+            let below = dpat.len() - p0;
+            let top = ld.subrows(dw + p0, mid);
+            work.product.resize(below * mid, 0.0);
+            let prod =
+                MatMut::from_column_major_slice_mut(&mut work.product[..below * mid], below, mid);
+            let (prod_top, prod_bot) = prod.split_at_row_mut(mid);
+            // Only the lower triangle of the square part is scattered: computing just it
+            // halves the work where a separator's rows fall in this block.
+            if mid >= MIN_TRIANGULAR_PRODUCT {
+                triangular::matmul(
+                    prod_top,
+                    BlockStructure::TriangularLower,
+                    Accum::Replace,
+                    top,
+                    BlockStructure::Rectangular,
+                    top.transpose(),
+                    BlockStructure::Rectangular,
+                    1.0,
+                    Par::Seq,
+                );
+            } else {
+                matmul(
+                    prod_top,
+                    Accum::Replace,
+                    top,
+                    top.transpose(),
+                    1.0,
+                    Par::Seq,
+                );
+            }
+            if below > mid {
+                let rest = ld.subrows(dw + p0 + mid, below - mid);
+                matmul(
+                    prod_bot,
+                    Accum::Replace,
+                    rest,
+                    top.transpose(),
+                    1.0,
+                    Par::Seq,
+                );
+            }
+            // Rows of the product in `k`'s block, then each column's lower part scattered.
+            let rows_d = &dpat[p0..];
+            work.target.clear();
+            work.target.extend(
+                rows_d
+                    .iter()
+                    .map(|&r| if r < se { r - sb } else { local[r] }),
+            );
+            for (j, src) in work.product[..below * mid].chunks_exact(below).enumerate() {
+                let dst = &mut part[(rows_d[j] - lo) * rows..][..rows];
+                for (&ri, &v) in work.target[j..].iter().zip(&src[j..]) {
+                    dst[ri] -= v;
+                }
+            }
+        }
+    }
+}
+
+/// Buffers of one thread's updates: one product and the rows it lands on.
+#[derive(Default)]
+struct UpdateWork {
+    /// One update product, column-major.
+    product: Vec<f64>,
+    /// Place in the current supernode's block of each row of the product.
+    target: Vec<usize>,
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::bench::cholmod::{lattice_system, relative_residual};
+    use crate::linalg::cholesky::{CholeskyError, CholeskyOptions, SparseCholesky};
+
+    fn analyzed(s: &crate::bench::cholmod::LowerSystem) -> SparseCholesky {
+        let options = CholeskyOptions {
+            threads: 2,
+            ..Default::default()
+        };
+        SparseCholesky::analyze_with(s.n, &s.col_ptr, &s.row_idx, s.groups.as_deref(), options)
+            .unwrap()
+    }
+
+    #[test]
+    fn tree_factor_solves_like_faers_loop() {
+        // 16×16×25 cells, 21,675 DOFs: large enough for the tree plan (MIN_TREE_DOFS, MIN_TREE_WORK).
+        let (s, _) = lattice_system([16, 16, 25]).unwrap();
+        let mut tree = analyzed(&s);
+        assert!(tree.is_tree_parallel());
+        let mut plain = analyzed(&s);
+        plain.disable_tree_parallel();
+        assert!(!plain.is_tree_parallel());
+        let (mut x, mut y) = (s.rhs.clone(), s.rhs.clone());
+        tree.factorize(&s.values).unwrap();
+        plain.factorize(&s.values).unwrap();
+        tree.solve_in_place(&mut x);
+        plain.solve_in_place(&mut y);
+        // faer's own loop reaches about 1e-13 here (cond(K) is large: a slender lattice).
+        let (rt, rp) = (relative_residual(&s, &x), relative_residual(&s, &y));
+        assert!(
+            rt < 1e-12 && rp < 1e-12,
+            "residuals {rt:e} (tree), {rp:e} (faer's loop)"
+        );
+        let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = x
+            .iter()
+            .zip(&y)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(
+            diff <= 1e-11 * scale,
+            "max difference {diff:e} of {scale:e}"
+        );
+        // Refactoring new values on the same pattern gives the new answer.
+        let doubled: Vec<f64> = s.values.iter().map(|v| 2.0 * v).collect();
+        tree.factorize(&doubled).unwrap();
+        let mut z = s.rhs.clone();
+        tree.solve_in_place(&mut z);
+        let diff = z
+            .iter()
+            .zip(&x)
+            .fold(0.0f64, |m, (a, b)| m.max((2.0 * a - b).abs()));
+        assert!(diff <= 1e-11 * scale, "max difference {diff:e}");
+    }
+
+    #[test]
+    fn tree_factor_names_a_negative_pivot_by_its_dof() {
+        let (mut s, _) = lattice_system([16, 16, 25]).unwrap();
+        // A negative diagonal entry fails exactly at its own pivot, in either loop.
+        let dof = 1234;
+        s.values[s.col_ptr[dof]] = -1.0;
+        for tree in [true, false] {
+            let mut c = analyzed(&s);
+            if !tree {
+                c.disable_tree_parallel();
+            }
+            assert_eq!(c.is_tree_parallel(), tree);
+            assert_eq!(
+                c.factorize(&s.values),
+                Err(CholeskyError::NonPositivePivot { dof }),
+                "tree = {tree}"
+            );
+            assert!(!c.is_factorized());
+        }
+    }
+}
