@@ -62,8 +62,10 @@ fn query(cells: usize) {
 }
 
 /// The pair of boxes with `n` cells per edge; with `Some(μ)` (0 for frictionless), sheared
-/// from step 2 with Coulomb coefficient μ; with `None`, pressed only, frictionless.
-fn pair(n: usize, friction: Option<f64>) {
+/// from step 2 with Coulomb coefficient μ; with `None`, pressed only, frictionless. Returns
+/// each step's wall time, s; with `against` (the frictionless run's), prints each step's
+/// ratio to it.
+fn pair(n: usize, friction: Option<f64>, against: &[f64]) -> Vec<f64> {
     let h = 0.1;
     let scene = format!(
         r#"
@@ -145,6 +147,7 @@ total_force = [0.0, -500.0, 0.0]
         println!("       set-up CPU (both cores, this process) {cpu:.2} s");
     }
     let mut before = p0;
+    let mut seconds_per_step = Vec::with_capacity(STEPS);
     for step in 0..=STEPS {
         let t = Instant::now();
         let (_, summary) = sim.step(step).expect("solves");
@@ -155,8 +158,12 @@ total_force = [0.0, -500.0, 0.0]
         if step == 0 {
             continue;
         }
+        seconds_per_step.push(seconds);
+        let ratio = against.get(step - 1).map_or(String::new(), |f| {
+            format!(" ({:.1}× the frictionless step)", seconds / f)
+        });
         println!(
-            "       step {step}: {seconds:.2} s = factorization {:.2} s + ordering {:.2} s + solves {:.2} s + contact queries {:.3} s + residuals {:.2} s + rest; {} Newton, {} contact iterations, residual {:.1e}, max penetration {:.2e} m{}",
+            "       step {step}: {seconds:.2} s{ratio} = factorization {:.2} s + ordering {:.2} s + solves {:.2} s + contact queries {:.3} s + residuals {:.2} s + rest; {} Newton, {} contact iterations, residual {:.1e}, max penetration {:.2e} m{}",
             d[2],
             d[1],
             d[3],
@@ -180,6 +187,14 @@ total_force = [0.0, -500.0, 0.0]
         "       whole run (set-up and {STEPS} steps): {:.2} s{cpu}",
         start.elapsed().as_secs_f64()
     );
+    if against.len() == seconds_per_step.len() && !against.is_empty() {
+        let (a, b): (f64, f64) = (seconds_per_step.iter().sum(), against.iter().sum());
+        println!(
+            "       steps 1-{STEPS}: {a:.2} s against {b:.2} s frictionless: {:.1}×",
+            a / b
+        );
+    }
+    seconds_per_step
 }
 
 /// User plus system CPU time of this process so far, s (Linux `/proc/self/stat`; `None`
@@ -215,14 +230,14 @@ fn main() {
         None => 27,
     };
     if flag("--friction") {
-        pair(cells, Some(0.0));
-        pair(cells, Some(0.3));
+        let frictionless = pair(cells, Some(0.0), &[]);
+        pair(cells, Some(0.3), &frictionless);
         return;
     }
     // 2 (c + 1)² surface nodes: c = 70 gives 10,082; c = 223 gives 100,352.
     query(70);
     query(223);
     if !flag("--skip-pair") {
-        pair(cells, None);
+        pair(cells, None, &[]);
     }
 }

@@ -1,8 +1,8 @@
 //! The condensed Newton of the settle loop when every body is linear: on the contact candidates only, each body factored once per run.
 
 use crate::contact::condensed::{
-    CondenseFailure, CondensedBody, ContactJacobian, ContactRow, Correction, FrictionRow,
-    NOT_CANDIDATE,
+    exact_for, CondenseFailure, CondensedBody, ContactJacobian, ContactRow, Correction,
+    FrictionRow, APPROXIMATE_FROM, NOT_CANDIDATE,
 };
 use crate::contact::detect::widen;
 use crate::contact::evaluate::friction_key;
@@ -127,6 +127,10 @@ pub(crate) struct CondensedSolver {
     bodies: Vec<Condensation>,
     /// The factored Jacobian of the condensed contact problem and the set it was made for.
     jacobian: Option<(ContactSet, ContactJacobian)>,
+    /// Whether slipping contacts' rows follow their slip (`slip_axes`): the last placement had
+    /// [`APPROXIMATE_FROM`] rows or more (where a Jacobian may take their tangents
+    /// approximately, diagonal in these axes).
+    follow_slip: bool,
 }
 
 impl CondensedSolver {
@@ -163,6 +167,7 @@ impl CondensedSolver {
         let solver = CondensedSolver {
             bodies: built,
             jacobian: None,
+            follow_slip: false,
         };
         (Some(solver), None)
     }
@@ -398,7 +403,12 @@ impl CondensedSolver {
                 }
                 k3
             });
-            let axes = contact_axes(&n, parts[e.contact.body].dofs.dofs_per_node);
+            // A slipping contact's tangent rows follow its slip (see `slip_axes`).
+            let dims = parts[e.contact.body].dofs.dofs_per_node;
+            let axes = match slipping {
+                Some(_) if self.follow_slip => slip_axes(&n, &tangential.force, dims),
+                _ => contact_axes(&n, dims),
+            };
             let first = rows.len();
             let mut added = Vec::with_capacity(axes.len());
             for axis in &axes {
@@ -424,6 +434,7 @@ impl CondensedSolver {
                 });
             }
         }
+        self.follow_slip = rows.len() >= APPROXIMATE_FROM;
         if !missing.is_empty() {
             missing.sort_unstable();
             missing.dedup();
@@ -626,6 +637,10 @@ impl CondensedSolver {
             releases: 0,
         });
         let mut flips = Flips::default();
+        // Whether the last correction came from a kept Jacobian with friction, and whether
+        // one was formed afresh at an apparent floor already.
+        let (mut kept_friction, mut refreshed) = (false, false);
+
         // Iterations since the held contacts last changed (the law Newton solves changed).
         let mut counted = 0;
         loop {
@@ -688,14 +703,30 @@ impl CondensedSolver {
                 }
             }
             let size = self.candidate_norm(parts);
-            if p.converged(
+            let mut converged = p.converged(
                 &mut monitor,
                 residual.norm,
                 residual.scale,
                 counted,
                 last_step,
                 size,
-            )? {
+            )?;
+            // A kept Jacobian with friction converges linearly (see `FrictionInverse`), which
+            // can look like the round-off floor: above [`FLOOR_CHECKED`] tolerances, one more
+            // iteration with a fresh Jacobian decides.
+            if converged
+                && kept_friction
+                && !refreshed
+                && monitor
+                    .last()
+                    .is_some_and(|r| r > FLOOR_CHECKED * tolerance)
+                && jacobian.as_ref().is_some_and(|j| j.has_friction())
+            {
+                refreshed = true;
+                *jacobian = None;
+                converged = false;
+            }
+            if converged {
                 let beyond: Vec<FrictionKey> = residual
                     .friction
                     .iter()
@@ -732,6 +763,12 @@ impl CondensedSolver {
             // A Jacobian carried over from an earlier call is tried once.
             let near_floor = monitor.last().is_some_and(|r| r < 1e3 * p.tolerance);
             let fast = monitor.len() < 2 || monitor.converging_fast() || near_floor;
+            // With friction the kept Jacobian is a modified Newton's in the slipping
+            // contacts' tangents (see `FrictionInverse`): a steady linear rate is fast enough.
+            let steady = monitor.history.len() >= 2 && {
+                let h = &monitor.history;
+                h[h.len() - 1] < FRICTION_STEADY_RATE * h[h.len() - 2]
+            };
             let mut reuse = jacobian
                 .as_ref()
                 .is_some_and(|j: &ContactJacobian| j.rows().len() == residual.rows.len() && fast);
@@ -739,7 +776,7 @@ impl CondensedSolver {
             // stiffness: taken into the kept Jacobian (a Schur complement on the slipping
             // rows), its `G C Gᵀ` and factor are formed again only after slow iterations.
             if let Some(j) = jacobian.as_mut().filter(|j| j.has_friction()) {
-                if !fast {
+                if !(fast || steady && j.is_approximate()) {
                     slow += 1;
                 }
                 // While Newton converges fast and no contact starts or stops slipping, the
@@ -751,11 +788,16 @@ impl CondensedSolver {
             }
             if !reuse {
                 slow = 0;
-                *jacobian = ContactJacobian::new(&views, residual.rows, stabilisation).ok();
+                // Many friction rows: the slipping contacts' tangents approximately (their
+                // exact Schur complement would cost more than the factor, see
+                // `FrictionInverse`); few: exactly, Newton's quadratic convergence.
+                let exact = exact_for(&residual.rows);
+                *jacobian = ContactJacobian::new(&views, residual.rows, stabilisation, exact).ok();
             }
             let Some(jac) = jacobian.as_ref() else {
                 return Ok(self.fall_back(parts, times));
             };
+            kept_friction = reuse && jac.is_approximate();
             let corr = jac.correction(&views, &residual.phi1, &residual.phi2);
             let base: Vec<(Vec<Real>, Vec<Real>)> = self
                 .bodies
@@ -889,11 +931,36 @@ fn reversals(h: &Holding, at: &[FrictionState], trial: &[FrictionState]) -> Vec<
 /// is kept for, its contacts' stiffnesses brought up to date, before it is formed again.
 const FRICTION_SLOW_ITERATIONS: usize = 3;
 
+/// A friction Newton that seems to stall above this many tolerances with a kept Jacobian is
+/// given a fresh one first (the 20,000-node pair's floor is about 10 tolerances).
+const FLOOR_CHECKED: Real = 30.0;
+
+/// The residual ratio between iterations below which a kept Jacobian with friction counts
+/// as converging (its slipping contacts' tangents are those of its factorization).
+const FRICTION_STEADY_RATE: Real = 0.5;
+
 /// Add a condensation's analysis, factorization and solve times to `times`.
 fn add_seconds(times: &mut PhaseTimes, c: &CondensedBody) {
     times.symbolic += c.seconds[0];
     times.numeric += c.seconds[1];
     times.solve += c.seconds[2];
+}
+
+/// The directions of a slipping contact's rows: its normal `n`, its tangential force's
+/// direction (from `force`, N), then in 3D the direction across both; those of
+/// [`contact_axes`] when the force has no tangential direction. In these axes the slip tangent
+/// is diagonal but for its coupling `μ k_n t nᵀ` (see `FrictionInverse`'s reference).
+fn slip_axes(n: &Vector3<Real>, force: &Vector3<Real>, d: usize) -> Vec<Vector3<Real>> {
+    let along = force - n * n.dot(force);
+    let size = along.norm();
+    if !(size > 0.0 && size.is_finite()) {
+        return contact_axes(n, d);
+    }
+    let t = along / size;
+    if d < 3 {
+        return vec![*n, t];
+    }
+    vec![*n, t, n.cross(&t)]
 }
 
 /// The directions of a friction contact's rows: its normal `n`, then an orthonormal basis of
