@@ -1249,3 +1249,63 @@ normal = [0.0, 1.0]
         "{error}"
     );
 }
+
+/// The boxes of `stacked_boxes` 0.1 m (and 0.8 m) apart, more than the candidates' margin of a
+/// quarter member: no node is a candidate at first; the upper box falls onto the lower face to
+/// face, the candidates of both grow, and the answer should be the coupled solve's at every
+/// step (displacements to 1e-6 of the largest, the total contact force to 1e-6 relative).
+///
+/// Ignored: it fails (gap 0.1, step 1: lower body 1.3e-4 m off of 1.39e-2 m, 0.9%; total force
+/// 500 N on both paths). Both paths end with the same 48 contact nodes but different patches:
+/// the faces' nodes coincide with the other face's vertices, so each node lies in several
+/// patches and `Geometry::keep_patches` keeps whichever the path pressed first. Both sets are
+/// settled (found == solved); the discrete problem has more than one answer there, and the
+/// condensed candidates miss no node. Kept as the reproduction for the fix (a patch choice
+/// that does not depend on the path).
+#[test]
+#[ignore = "path-dependent patch choice at coincident vertices, see the doc comment"]
+fn boxes_meeting_face_to_face_after_growing_match_the_coupled_solve() {
+    for gap in [0.1, 0.8] {
+        let mut world = build_world(&stacked_boxes(gap), Path::new("stacked.toml")).unwrap();
+        let mut sim = Simulation::new(&world).unwrap();
+        let count = |sim: &Simulation, body: usize| {
+            sim.contact()
+                .and_then(|c| c.candidate_nodes(body))
+                .expect("condensed")
+        };
+        assert_eq!(
+            (count(&sim, 0), count(&sim, 1)),
+            (0, 0),
+            "gap {gap}: nothing is near"
+        );
+        let condensed: Vec<_> = (0..=world.steps).map(|k| sim.step(k).unwrap()).collect();
+        world.contact.condense = false;
+        let coupled = run_all(&world);
+        for ((a, _), (b, _)) in condensed.iter().zip(&coupled).skip(1) {
+            let total =
+                |r: &StepResult| -> f64 { r.bodies[1].contacts.iter().map(|c| c.force[1]).sum() };
+            let (fa, fb) = (total(a), total(b));
+            for body in 0..2 {
+                let largest = b.bodies[body]
+                    .displacements
+                    .iter()
+                    .flat_map(|u| u.iter())
+                    .fold(0.0_f64, |m, x| m.max(x.abs()));
+                let worst = a.bodies[body]
+                    .displacements
+                    .iter()
+                    .zip(&b.bodies[body].displacements)
+                    .flat_map(|(ua, ub)| ua.iter().zip(ub).map(|(x, y)| (x - y).abs()))
+                    .fold(0.0_f64, f64::max);
+                assert!(
+                    worst <= 1e-6 * largest,
+                    "gap {gap} body {body}: {worst} of {largest}"
+                );
+            }
+            assert!(
+                (fa - fb).abs() <= 1e-6 * fb.abs(),
+                "gap {gap}: {fa} vs {fb}"
+            );
+        }
+    }
+}
