@@ -45,3 +45,4 @@ mod settings;
 mod settle;
 mod start;
 mod surface;
+mod ties;
