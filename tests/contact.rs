@@ -1249,3 +1249,129 @@ normal = [0.0, 1.0]
         "{error}"
     );
 }
+
+/// The boxes of `stacked_boxes` 0.1 m (and 0.8 m) apart, more than the candidates' margin of a
+/// quarter member: no node is a candidate at first; the upper box falls onto the lower face to
+/// face, the candidates of both grow, and the answer is the coupled solve's at every step
+/// (displacements to 1e-6 of the largest, the total contact force to 1e-6 relative).
+///
+/// Ignored: it fails. The faces' nodes coincide with the other face's corners, so each node lies
+/// in several patches at once, and `Geometry::keep_patches` keeps whichever the path pressed
+/// first (17 of 48 contacts differ; 0.9% in displacements at gap 0.1). A position-only rule
+/// (branch `ties`: the tie rule of `contact::ties` for contact between bodies, without
+/// `keep_patches`) made the face nodes agree (normals to about 1e-5 instead of ±0.013) but
+/// not the nodes at the boxes' edges, which lie in the other box's side planes and press a side
+/// patch or the top depending on the path (1.3% left); it also made `stack` flip. Kept as the
+/// reproduction for that fix.
+#[test]
+#[ignore = "path-dependent patch choice between bodies, see the doc comment"]
+fn boxes_meeting_face_to_face_after_growing_match_the_coupled_solve() {
+    for gap in [0.1, 0.8] {
+        let mut world = build_world(&stacked_boxes(gap), Path::new("stacked.toml")).unwrap();
+        let mut sim = Simulation::new(&world).unwrap();
+        let count = |sim: &Simulation, body: usize| {
+            sim.contact()
+                .and_then(|c| c.candidate_nodes(body))
+                .expect("condensed")
+        };
+        assert_eq!(
+            (count(&sim, 0), count(&sim, 1)),
+            (0, 0),
+            "gap {gap}: nothing is near"
+        );
+        let condensed: Vec<_> = (0..=world.steps).map(|k| sim.step(k).unwrap()).collect();
+        world.contact.condense = false;
+        let coupled = run_all(&world);
+        for ((a, _), (b, _)) in condensed.iter().zip(&coupled).skip(1) {
+            let total =
+                |r: &StepResult| -> f64 { r.bodies[1].contacts.iter().map(|c| c.force[1]).sum() };
+            let (fa, fb) = (total(a), total(b));
+            for body in 0..2 {
+                let largest = b.bodies[body]
+                    .displacements
+                    .iter()
+                    .flat_map(|u| u.iter())
+                    .fold(0.0_f64, |m, x| m.max(x.abs()));
+                let worst = a.bodies[body]
+                    .displacements
+                    .iter()
+                    .zip(&b.bodies[body].displacements)
+                    .flat_map(|(ua, ub)| ua.iter().zip(ub).map(|(x, y)| (x - y).abs()))
+                    .fold(0.0_f64, f64::max);
+                assert!(
+                    worst <= 1e-6 * largest,
+                    "gap {gap} body {body}: {worst} of {largest}"
+                );
+            }
+            assert!(
+                (fa - fb).abs() <= 1e-6 * fb.abs(),
+                "gap {gap}: {fa} vs {fb}"
+            );
+        }
+    }
+}
+
+/// A box pressed centrally on a box with coincident nodes (`stacked_boxes` with no gap): the
+/// set-up is mirror-symmetric about the plane x = z (the lattice, its patches' diagonals, the
+/// lower box's support, the upper box's two support lines (0, y, 0) and (1, y, 1) and its load
+/// all map onto themselves), and every node of a face meets a corner of the other face, where
+/// several patches tie. The answer is mirror-symmetric to 1e-9 of the largest displacement on
+/// both paths (node (i, j, k) moves as node (k, j, i) with x and z swapped), and the contact
+/// forces on the two boxes are equal and opposite and carry the 1,000 N load (1e-9).
+///
+/// Ignored: it fails (the tie rule acts on self-contact only so far; with it tried between
+/// bodies too the condensed path was symmetric only to 4.9e-4 m of 2.7e-2 m, the nodes at
+/// the boxes' edges pressing the other box's side patches). Kept as the target for that rule.
+#[test]
+#[ignore = "the tie rule does not yet act between bodies, see the doc comment"]
+fn a_box_pressed_on_a_box_with_coincident_nodes_gives_a_mirror_symmetric_answer() {
+    for condense in [true, false] {
+        let mut world = build_world(&stacked_boxes(0.0), Path::new("stacked.toml")).unwrap();
+        world.contact.condense = condense;
+        let (last, _) = run_all(&world).pop().unwrap();
+        let mirror = |n: usize| {
+            let (i, j, k) = (n % 5, (n / 5) % 5, n / 25);
+            k + 5 * (j + 5 * i)
+        };
+        for body in 0..2 {
+            let u = &last.bodies[body].displacements;
+            let largest = u
+                .iter()
+                .flat_map(|d| d.iter())
+                .fold(0.0_f64, |m, x| m.max(x.abs()));
+            let worst = (0..u.len())
+                .map(|n| {
+                    let (a, b) = (&u[n], &u[mirror(n)]);
+                    (a[0] - b[2])
+                        .abs()
+                        .max((a[1] - b[1]).abs())
+                        .max((a[2] - b[0]).abs())
+                })
+                .fold(0.0_f64, f64::max);
+            eprintln!("condense {condense} body {body}: mirror symmetry to {worst} of {largest}");
+            assert!(largest > 0.0);
+            assert!(
+                worst <= 1e-9 * largest,
+                "condense {condense} body {body}: {worst} of {largest}"
+            );
+        }
+        let total = |body: usize| -> [f64; 3] {
+            let mut f = [0.0; 3];
+            for c in &last.bodies[body].contacts {
+                for (total, component) in f.iter_mut().zip(&c.force) {
+                    *total += component;
+                }
+            }
+            f
+        };
+        let (lower, upper) = (total(0), total(1));
+        eprintln!("condense {condense}: contact force on the lower box {lower:?}, upper {upper:?}");
+        for k in 0..3 {
+            assert!(
+                (lower[k] + upper[k]).abs() <= 1e-9 * 1000.0,
+                "{lower:?} {upper:?}"
+            );
+        }
+        assert!((upper[1] - 1000.0).abs() <= 1e-9 * 1000.0, "{upper:?}");
+    }
+}

@@ -60,6 +60,27 @@ pub enum Target {
         /// The broken member (index in the body's members); the node is its first end.
         member: usize,
     },
+    /// An edge between two surface patches of a 3D body, pressed along the area-weighted mean
+    /// normal of its two patches: the node's nearest point of the surface lies on both patches
+    /// (a tie, see `contact::ties`).
+    Edge {
+        /// The body (index in the scene).
+        body: usize,
+        /// The body nodes at the edge's ends, 0-based, smaller first.
+        nodes: [usize; 2],
+    },
+    /// A surface node (corner) of a 3D body, pressed along the area-weighted mean normal of
+    /// the patches around it that the node is equally near: its nearest point of the surface
+    /// is that corner, on several patches at once (a tie, see `contact::ties`).
+    Corner {
+        /// The body (index in the scene).
+        body: usize,
+        /// The body node at the corner, 0-based.
+        node: usize,
+        /// Which patches around the corner tied: bit i for the i-th of them in ascending
+        /// patch order (`PatchSurface::fan`).
+        tied: u64,
+    },
 }
 
 /// The active contacts, sorted: two sets compare equal when the same nodes touch the same

@@ -190,7 +190,9 @@ impl Geometry {
             Target::Segment { body, .. }
             | Target::Vertex { body, .. }
             | Target::Patch { body, .. }
-            | Target::Closing { body, .. } => &bodies[body].name,
+            | Target::Closing { body, .. }
+            | Target::Edge { body, .. }
+            | Target::Corner { body, .. } => &bodies[body].name,
             Target::Sharp { obstacle, .. } => self.obstacles.name(obstacle),
         }
     }
@@ -452,7 +454,11 @@ impl Geometry {
                         consider(Target::Patch { body: other, patch }, depth);
                     }
                 }
-                if let Some((target, depth)) = self.own.deepest(&own, (b, node), &x, min_depth) {
+                let own_surface = self.patch_surfaces[b].as_ref();
+                if let Some((target, depth)) =
+                    self.own
+                        .deepest(&own, own_surface, (b, node), &x, min_depth)
+                {
                     consider(target, depth);
                 }
                 if let Some((with, _)) = deepest {

@@ -92,7 +92,9 @@ pub(crate) fn friction_key(c: &ActiveContact) -> (FrictionKey, Option<(usize, Re
         Target::Patch { body, .. }
         | Target::Segment { body, .. }
         | Target::Vertex { body, .. }
-        | Target::Closing { body, .. } => (
+        | Target::Closing { body, .. }
+        | Target::Edge { body, .. }
+        | Target::Corner { body, .. } => (
             FrictionKey::Body {
                 body: c.body,
                 node: c.node,
@@ -202,6 +204,10 @@ pub(crate) fn evaluate(
             Target::Patch { body, patch } => on_patch(geometry, bodies, parts, c, body, patch, &x),
             Target::Vertex { body, vertex } => {
                 on_vertex(geometry, bodies, parts, c, body, vertex, &x)
+            }
+            Target::Edge { body, nodes } => on_edge(geometry, bodies, parts, c, body, nodes, &x),
+            Target::Corner { body, node, tied } => {
+                on_corner(geometry, bodies, parts, c, (body, node, tied), &x)
             }
             Target::Segment { body, segment } => {
                 on_segment(geometry, bodies, parts, c, body, segment, &x)
@@ -375,6 +381,72 @@ fn on_patch(
             (body, b, -t.weights[1]),
             (body, cc, -t.weights[2]),
         ],
+        penalty: pair_penalty(parts, c.body, body),
+    })
+}
+
+/// A node at `x` against the edge `nodes` of 3D body `body`'s closed surface (a tie between
+/// its two patches, see `contact::ties`): along the area-weighted mean of their normals
+/// (perpendicular to the edge), the depth measured from the edge, the force shared by the
+/// edge's ends by the node's position along it (its nearest point of the edge).
+///
+/// The tangent is the frozen-normal one every patch contact uses (`k n nᵀ` over the nodes'
+/// weights): it leaves out the turning of the normal and the sliding of the weights with the
+/// nodes, which are of the order of the depth over a member and vanish as the bodies come to
+/// rest on each other.
+fn on_edge(
+    geometry: &Geometry,
+    bodies: &[Body],
+    parts: &[BodyPart],
+    c: &ActiveContact,
+    body: usize,
+    nodes: [usize; 2],
+    x: &Vector3<Real>,
+) -> Option<Touch> {
+    let surface = geometry.patch_surfaces[body].as_ref()?;
+    let at = |n: usize| position(bodies, parts, body, n);
+    let normal = surface.mean_normal(&surface.edge_patches(nodes), at);
+    let (pa, pb) = (at(nodes[0]), at(nodes[1]));
+    let e = pb - pa;
+    let length2 = e.norm_squared();
+    let t = if length2 > 0.0 {
+        ((x - pa).dot(&e) / length2).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    let depth = normal.map_or(0.0, |n| (pa - x).dot(&n));
+    Some(Touch {
+        depth,
+        normal,
+        nodes: vec![
+            (c.body, c.node, 1.0),
+            (body, nodes[0], -(1.0 - t)),
+            (body, nodes[1], -t),
+        ],
+        penalty: pair_penalty(parts, c.body, body),
+    })
+}
+
+/// A node at `x` against the corner `node` of 3D body `body`'s closed surface (a tie between
+/// the patches around it selected by `tied`, see `contact::ties`): along the area-weighted mean
+/// of those patches' normals, the depth measured from the corner, the force on the corner
+/// node alone (the tangent as in [`on_edge`]).
+fn on_corner(
+    geometry: &Geometry,
+    bodies: &[Body],
+    parts: &[BodyPart],
+    c: &ActiveContact,
+    (body, node, tied): (usize, usize, u64),
+    x: &Vector3<Real>,
+) -> Option<Touch> {
+    let surface = geometry.patch_surfaces[body].as_ref()?;
+    let at = |n: usize| position(bodies, parts, body, n);
+    let normal = surface.mean_normal(&surface.fan_tied(node, tied), at);
+    let depth = normal.map_or(0.0, |n| (at(node) - x).dot(&n));
+    Some(Touch {
+        depth,
+        normal,
+        nodes: vec![(c.body, c.node, 1.0), (body, node, -1.0)],
         penalty: pair_penalty(parts, c.body, body),
     })
 }

@@ -418,7 +418,9 @@ impl ContactFracture {
             }
             let (Target::Segment { body: o, .. }
             | Target::Patch { body: o, .. }
-            | Target::Vertex { body: o, .. }) = c.with
+            | Target::Vertex { body: o, .. }
+            | Target::Edge { body: o, .. }
+            | Target::Corner { body: o, .. }) = c.with
             else {
                 continue;
             };

@@ -47,3 +47,4 @@ mod settings;
 mod settle;
 mod start;
 mod surface;
+mod ties;

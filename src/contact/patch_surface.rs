@@ -1,6 +1,8 @@
 //! The contact surface of a 3D body: its patches as a parry `TriMesh` (oriented for a closed
 //! surface, two-sided for an open shell), rebuilt from the deformed nodes at every query.
 
+use crate::contact::ties::{self, Pressed};
+use crate::contact::Target;
 use crate::linkage::Body;
 use crate::Real;
 use nalgebra::Vector3;
@@ -23,6 +25,8 @@ pub struct PatchSurface {
     pub rim_edges: Vec<[bool; 3]>,
     /// Open shell only: per patch, whether its corners a, b, c are on the rim.
     pub rim_corners: Vec<[bool; 3]>,
+    /// Per surface node (by position in `nodes`), the patches around it, ascending.
+    pub fans: Vec<Vec<usize>>,
 }
 
 /// Where a point lies against an open shell.
@@ -88,12 +92,14 @@ impl PatchSurface {
         let mut nodes: Vec<usize> = patches.iter().flatten().copied().collect();
         nodes.sort_unstable();
         nodes.dedup();
+        let fans = fans(&patches, &nodes);
         Ok(Some(PatchSurface {
             patches,
             nodes,
             flipped,
             rim_edges: Vec::new(),
             rim_corners: Vec::new(),
+            fans,
         }))
     }
 
@@ -136,13 +142,129 @@ impl PatchSurface {
         let mut nodes: Vec<usize> = body.patches.iter().flatten().copied().collect();
         nodes.sort_unstable();
         nodes.dedup();
+        let fans = fans(&body.patches, &nodes);
         Some(PatchSurface {
             patches: body.patches.clone(),
             nodes,
             flipped: false,
             rim_edges,
             rim_corners,
+            fans,
         })
+    }
+
+    /// The patches around body node `node`, ascending (empty off the surface).
+    pub fn fan(&self, node: usize) -> &[usize] {
+        self.nodes
+            .binary_search(&node)
+            .map_or(&[], |i| self.fans[i].as_slice())
+    }
+
+    /// The patches having both `a` and `b` as corners (two on a closed surface), ascending.
+    pub fn edge_patches(&self, [a, b]: [usize; 2]) -> Vec<usize> {
+        let around_b = self.fan(b);
+        self.fan(a)
+            .iter()
+            .filter(|p| around_b.contains(p))
+            .copied()
+            .collect()
+    }
+
+    /// The area-weighted mean of the outward normals of `patches` at the positions
+    /// `position(node)`, as a unit vector (`None` when they cancel or are degenerate): the sum
+    /// of their corners' cross products, each twice its patch's area times its normal.
+    pub fn mean_normal(
+        &self,
+        patches: &[usize],
+        position: impl Fn(usize) -> Vector3<Real>,
+    ) -> Option<Vector3<Real>> {
+        let sum: Vector3<Real> = patches
+            .iter()
+            .map(|&p| {
+                let [a, b, c] = self.patches[p].map(&position);
+                (b - a).cross(&(c - a))
+            })
+            .sum();
+        let length = sum.norm();
+        (length > 0.0 && length.is_finite()).then(|| sum / length)
+    }
+
+    /// The contact target of body `body` (whose surface this is) for a node at `x` (m) that
+    /// the tie rule sent to `pressed` (positions `position(node)`, m), by `contact::ties`: a
+    /// single patch whose foot lies within [`ties::BAND`] of an edge or corner of it presses
+    /// that edge or corner; an edge or corner presses with the patches around it that turn less
+    /// than 45° from the mean of those that tied (not the side faces beyond a box's edge). A
+    /// corner's patches are a mask over [`PatchSurface::fan`] (more than 64: the patch).
+    pub(crate) fn target(
+        &self,
+        body: usize,
+        pressed: Pressed,
+        x: &Vector3<Real>,
+        position: impl Fn(usize) -> Vector3<Real>,
+    ) -> Target {
+        let normal = |p: usize| {
+            let [a, b, c] = self.patches[p].map(&position);
+            (b - a).cross(&(c - a)).try_normalize(0.0)
+        };
+        let (feature, tied) = match pressed {
+            Pressed::Patch(patch) => match ties::near_feature(x, &self.patches[patch], &position) {
+                Some(feature) => (feature, vec![patch]),
+                None => return Target::Patch { body, patch },
+            },
+            Pressed::Edge(nodes) => (Pressed::Edge(nodes), self.edge_patches(nodes)),
+            Pressed::Corner(node, tied) => (Pressed::Corner(node, Vec::new()), tied),
+        };
+        let lowest = tied.iter().copied().min().unwrap_or(0);
+        let Some(reference) = self.mean_normal(&tied, &position) else {
+            return Target::Patch {
+                body,
+                patch: lowest,
+            };
+        };
+        let smooth = |p: &usize| normal(*p).is_some_and(|n| n.dot(&reference) >= ties::SMOOTH_COS);
+        match feature {
+            Pressed::Edge(nodes) => {
+                if self.edge_patches(nodes).iter().all(smooth) {
+                    Target::Edge { body, nodes }
+                } else {
+                    Target::Patch {
+                        body,
+                        patch: lowest,
+                    }
+                }
+            }
+            Pressed::Corner(node, _) => {
+                let mut mask = 0u64;
+                for (i, p) in self.fan(node).iter().enumerate() {
+                    if smooth(p) {
+                        if i >= 64 {
+                            return Target::Patch {
+                                body,
+                                patch: lowest,
+                            };
+                        }
+                        mask |= 1 << i;
+                    }
+                }
+                Target::Corner {
+                    body,
+                    node,
+                    tied: mask,
+                }
+            }
+            Pressed::Patch(patch) => Target::Patch { body, patch },
+        }
+    }
+
+    /// The patches around corner `node` selected by `mask` (bit i: the i-th of
+    /// [`PatchSurface::fan`]).
+    pub fn fan_tied(&self, node: usize, mask: u64) -> Vec<usize> {
+        self.fan(node)
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| i < 64 && mask >> i & 1 == 1)
+            .map(|(_, &p)| p)
+            .collect()
     }
 
     /// Whether this is an open shell (a two-sided target).
@@ -237,6 +359,19 @@ impl PatchSurface {
         let distance = (Vector3::new(p.x, p.y, p.z) - x).norm();
         Some((patch as usize, distance))
     }
+}
+
+/// Per node of `nodes` (sorted body nodes), the patches around it, ascending.
+fn fans(patches: &[[usize; 3]], nodes: &[usize]) -> Vec<Vec<usize>> {
+    let mut fans = vec![Vec::new(); nodes.len()];
+    for (p, corners) in patches.iter().enumerate() {
+        for n in corners {
+            if let Ok(i) = nodes.binary_search(n) {
+                fans[i].push(p);
+            }
+        }
+    }
+    fans
 }
 
 /// Distance from `p` to the segment `a b`, m.

@@ -19,7 +19,9 @@
 //! never comes from their front. An unloaded body, and one under loads that do not fold it onto
 //! itself, has no self-contact: every node stays where it was against every segment.
 //! Of the segments a node meets this way, the nearest (smallest depth) is pressed, and the
-//! force is shared by the segment's ends as between two bodies.
+//! force is shared by the segment's ends as between two bodies; segments as deep as the nearest
+//! tie, and their shared vertex (3D: corner or edge) is pressed instead (`contact::ties`), so
+//! that the choice depends on neither the segments' order nor the path.
 //!
 //! **Crack faces.** A member broken in tension (its ends apart at the break) is a crack's
 //! bridge: when its ends come back closer than its rest length `L₀`, the crack has closed, and
@@ -35,13 +37,14 @@
 use crate::contact::boundary::{segment_projection, Surface};
 use crate::contact::patch_surface::PatchSurface;
 use crate::contact::settle::{position, BodyPart};
+use crate::contact::ties::{self, Candidate, Pressed};
 use crate::contact::{penetration_tolerance, ActiveContact, ContactSet, Penalty, Target};
 use crate::linkage::body_state::{linear_stretch, undeformed_axis};
 use crate::linkage::fracture::breaks_members;
 use crate::linkage::{member_stiffnesses, Body};
 use crate::Real;
 use nalgebra::Vector3;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 /// Segments (patches) with a corner within this many members of a node at rest are not its
 /// self-contact targets.
@@ -71,8 +74,8 @@ struct Own {
     near: Vec<Vec<usize>>,
     /// Node positions at the last solved state, m (empty before the first).
     start: Vec<Vector3<Real>>,
-    /// The self-contacts held there: (node, target).
-    held: HashSet<(usize, Target)>,
+    /// The self-contacts held there: per node, its targets.
+    held: HashMap<usize, Vec<Target>>,
     /// Per member: `None` intact; `Some(true)` broken with its ends apart (closes as a crack),
     /// `Some(false)` broken with its ends together (crushed: never closes).
     broken: Vec<Option<bool>>,
@@ -161,7 +164,7 @@ impl SelfContact {
                 Some(Own {
                     near,
                     start: Vec::new(),
-                    held: HashSet::new(),
+                    held: HashMap::new(),
                     broken: vec![None; body.members.len()],
                     reach: SELF_REACH_MEMBERS * 100.0 * tolerance,
                     tolerance,
@@ -186,12 +189,12 @@ impl SelfContact {
                 .map(|n| position(bodies, parts, b, n))
                 .collect();
             own.tolerance = parts[b].tolerance;
-            own.held = active
-                .contacts
-                .iter()
-                .filter(|c| c.body == b && target_body(c.with) == Some(b))
-                .map(|c| (c.node, c.with))
-                .collect();
+            own.held = HashMap::new();
+            for c in &active.contacts {
+                if c.body == b && target_body(c.with) == Some(b) {
+                    own.held.entry(c.node).or_default().push(c.with);
+                }
+            }
             let stiffness = member_stiffnesses(&bodies[b]);
             for (m, k) in stiffness.iter().enumerate() {
                 if *k > 0.0 {
@@ -265,6 +268,7 @@ impl SelfContact {
     pub(crate) fn deepest(
         &self,
         grid: &SelfGrid,
+        surface: Option<&PatchSurface>,
         (b, node): (usize, usize),
         x: &Vector3<Real>,
         min_depth: Real,
@@ -274,7 +278,7 @@ impl SelfContact {
         let near = own.near.get(node).filter(|n| !n.is_empty())?;
         let list = grid.cells.get(&grid.cell(x))?;
         let corners = &grid.corners;
-        let mut best: Option<(Target, Real)> = None;
+        let mut candidates: Vec<Candidate> = Vec::new();
         for &t in list {
             let [lo, hi] = &grid.boxes[t];
             if (0..3).any(|k| x[k] < lo[k] || x[k] > hi[k]) {
@@ -284,14 +288,6 @@ impl SelfContact {
             if nodes.iter().any(|n| near.binary_search(n).is_ok()) {
                 continue;
             }
-            let target = if nodes.len() == 2 {
-                Target::Segment {
-                    body: b,
-                    segment: t,
-                }
-            } else {
-                Target::Patch { body: b, patch: t }
-            };
             let now: Vec<Vector3<Real>> = nodes.iter().map(|&n| grid.now[n]).collect();
             let Some((depth, on)) = behind(x, &now) else {
                 continue;
@@ -299,18 +295,42 @@ impl SelfContact {
             if !on || depth <= min_depth || depth > own.reach {
                 continue;
             }
-            if !own.held.contains(&(node, target)) {
+            let held = own.held.get(&node).map_or(&[][..], Vec::as_slice);
+            if !held_on(held, t, nodes, corners.len()) {
                 let then: Vec<Vector3<Real>> = nodes.iter().map(|&n| own.start[n]).collect();
                 match behind(&own.start[node], &then) {
                     Some((d, _)) if d <= own.tolerance => {}
                     _ => continue,
                 }
             }
-            if best.is_none_or(|(_, d)| depth < d) {
-                best = Some((target, depth));
-            }
+            candidates.push(Candidate {
+                index: t,
+                corners: nodes,
+                distance: depth,
+            });
         }
-        best
+        let nearest = candidates
+            .iter()
+            .min_by(|p, q| p.distance.total_cmp(&q.distance))?;
+        let (depth, corners_of_nearest) = (nearest.distance, nearest.corners);
+        let longest = corners_of_nearest
+            .iter()
+            .flat_map(|&p| corners_of_nearest.iter().map(move |&q| (p, q)))
+            .map(|(p, q)| (grid.now[p] - grid.now[q]).norm())
+            .fold(0.0, Real::max);
+        let target = match ties::pressed(&candidates, ties::TIE * longest)? {
+            Pressed::Patch(t) if corners[t].len() == 2 => Target::Segment {
+                body: b,
+                segment: t,
+            },
+            // 2D: the vertex's place in the boundary loop is that of the segment it starts.
+            Pressed::Corner(v, _) if corners_of_nearest.len() == 2 => Target::Vertex {
+                body: b,
+                vertex: corners.iter().position(|c| c[0] == v)?,
+            },
+            pressed => surface?.target(b, pressed, x, |n| grid.now[n]),
+        };
+        Some((target, depth))
     }
 
     /// The broken members of self-contact bodies whose crack has closed (ends closer than the
@@ -343,13 +363,29 @@ impl SelfContact {
     }
 }
 
+/// Whether a node held at the last solved state on `held` (targets of its own body) was held
+/// on target `t` (corner nodes `nodes`; `count` targets in all), or on an edge or corner (2D:
+/// vertex) of it that a tie made it press (see `contact::ties`).
+fn held_on(held: &[Target], t: usize, nodes: &[usize], count: usize) -> bool {
+    held.iter().any(|&target| match target {
+        Target::Segment { segment, .. } => segment == t,
+        Target::Vertex { vertex, .. } => vertex == t || vertex == (t + 1) % count,
+        Target::Patch { patch, .. } => patch == t,
+        Target::Corner { node, .. } => nodes.contains(&node),
+        Target::Edge { nodes: [p, q], .. } => nodes.contains(&p) && nodes.contains(&q),
+        Target::Obstacle(_) | Target::Sharp { .. } | Target::Closing { .. } => false,
+    })
+}
+
 /// The body a contact's target belongs to (`None`: an obstacle).
 fn target_body(with: Target) -> Option<usize> {
     match with {
         Target::Segment { body, .. }
         | Target::Patch { body, .. }
         | Target::Vertex { body, .. }
-        | Target::Closing { body, .. } => Some(body),
+        | Target::Closing { body, .. }
+        | Target::Edge { body, .. }
+        | Target::Corner { body, .. } => Some(body),
         Target::Obstacle(_) | Target::Sharp { .. } => None,
     }
 }
