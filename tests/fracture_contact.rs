@@ -403,3 +403,180 @@ normal = [0.0, 1.0]
     let r = contacts[0]["normal_force"].as_f64().unwrap();
     assert!(close(r, 60e3, 1e-9), "{r}");
 }
+
+/// Write `name.toml` (2D, steel E A = 2e7 N breaking at `strength` = 250 MPa, `strong`: the
+/// same, not breaking; `soft`: E A = 1e6 N, not breaking) with `nodes`, `links` and `rest`
+/// into `d`, and run it into `d/out`.
+fn run_truss(
+    d: &std::path::Path,
+    name: &str,
+    steps: usize,
+    strength: &str,
+    (nodes, links): (&str, &str),
+    rest: &str,
+) -> linkage::scene::Summary {
+    std::fs::write(d.join(format!("{name}.nodes")), nodes).unwrap();
+    std::fs::write(d.join(format!("{name}.links")), links).unwrap();
+    let scene = d.join(format!("{name}.toml"));
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "{name}"
+steps = {steps}
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+{strength} = 250e6
+failure = "break"
+[[materials]]
+name = "strong"
+youngs_modulus = 200e9
+area = 1e-4
+[[materials]]
+name = "soft"
+youngs_modulus = 200e9
+area = 5e-6
+[[bodies]]
+name = "truss"
+nodes = "{name}.nodes"
+links = "{name}.links"
+material = "steel"
+{rest}"#
+        ),
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    run(&world, &d.join("out"), &|| {}).expect("a result")
+}
+
+/// The indeterminate three-bar truss of `tests/fracture.rs` (node 1 at the origin held by a
+/// vertical bar, member 2, and two bars at 45°, members 1 and 3, from (−1, 1), (0, 1), (1, 1);
+/// P down at node 1 over 2 steps to 100 kN; f_t A = 25 kN) in a scene with contact: a
+/// `[contact]` table and a floor 5 m below that it never reaches. Member 2 breaks at
+/// P₁ = f_t A (1 + 1/√2) = 42.68 kN; the two left carry P/√2 each and are beyond their strength
+/// from P₂ = √2 f_t A = 35.36 kN: the snap-back. Member 1 breaks there (ties by number), at the
+/// LOWER load factor, and node 1, left on member 3, falls off. The load factors equal the
+/// closed form and the run without contact to 1e-9 (no contact: every settle is linear and
+/// the secant lands on the strength exactly, up to rounding).
+#[test]
+fn the_three_bar_truss_snaps_back_in_a_scene_with_contact_as_without() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let truss = ("0 0\n-1 1\n0 1\n1 1\n", "1 2\n1 3\n1 4\n");
+    let loads = r#"[[bodies.supports]]
+nodes = [2, 3, 4]
+fix = ["x", "y"]
+[[bodies.loads]]
+nodes = [1]
+force = [0.0, -100000.0]
+"#;
+    let contact = format!(
+        r#"{loads}
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, -5.0]
+normal = [0.0, 1.0]
+[contact]
+penalty = 1e9
+"#
+    );
+    let with = run_truss(d, "three_bar", 2, "tensile_strength", truss, &contact);
+    let without = run_truss(d, "three_bar_alone", 2, "tensile_strength", truss, loads);
+    let (fta, p) = (25e3, 100e3);
+    let p1 = fta * (1.0 + 1.0 / 2f64.sqrt());
+    let p2 = fta * 2f64.sqrt();
+    for summary in [&with, &without] {
+        assert!(summary.collapse.is_none() && summary.failure.is_none());
+        let breaks: Vec<(usize, usize)> =
+            summary.breaks.iter().map(|b| (b.step, b.member)).collect();
+        assert_eq!(breaks, vec![(1, 2), (1, 1)], "{:?}", summary.breaks);
+        assert!(close(summary.breaks[0].load_factor, p1 / p, 1e-9));
+        assert!(close(summary.breaks[1].load_factor, p2 / p, 1e-9));
+        assert!(summary.breaks[1].load_factor < summary.breaks[0].load_factor);
+    }
+    for (a, b) in with.breaks.iter().zip(&without.breaks) {
+        assert!(close(a.load_factor, b.load_factor, 1e-9), "{a:?} {b:?}");
+    }
+    let body = &step_json(d, "three_bar", 1)["bodies"][0];
+    assert_eq!(body["broken"], serde_json::json!([2, 1]));
+    assert_eq!(body["breaks"][1]["member"], 1);
+    assert_eq!(body["fallen"], serde_json::json!([1]));
+    for f in body["axial_forces"].as_array().unwrap() {
+        assert_eq!(f.as_f64().unwrap(), 0.0);
+    }
+}
+
+/// A snap-back under obstacle travel, with contact carrying the load: the three-bar truss
+/// (node 1 at the origin, members 1 and 2 breaking in compression at f_c A = 25 kN, member 3
+/// at 45° to (1, 1) strong; node 1 held in x) pushed up through a soft member (member 4 to
+/// node 5 at (0, −0.5), held in x: k_s = E A/L = 2e6 N/m) by a half-space `gap` = 1 mm below
+/// node 5 rising T = 30 mm over 4 steps; penalty k = 1e9 N/m. The press force is
+/// `F = (λ T − gap)/(1/k + 1/k_s + 1/K)` and node 1 rises `u = F/K`, K the truss's stiffness
+/// at node 1: E A (1 + 1/√2) intact, then E A/√2 without the vertical bar. The vertical bar
+/// carries E A u and breaks at u* = f_c A/(E A) = 1.25 mm, travel factor λ* = 0.7877 (step
+/// 4); then each inclined bar carries E A u/2, and at λ* u jumps past 2 u*: member 1 is
+/// beyond its strength, which it reaches at u = 2 u* and λ** = 0.7073: a snap-back below
+/// even the step's start (0.75), recorded there. Then node 1 rests on member 3 alone
+/// (K'' = E A/(2√2)), which carries −√2 F at the last step. Tolerance 1e-9: the contact set
+/// does not change between the settles that find the breaks, so the secant is exact.
+#[test]
+fn a_snap_back_under_obstacle_travel_with_contact_carrying_the_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let summary = run_truss(
+        d,
+        "pushed",
+        4,
+        "compressive_strength",
+        (
+            "0 0\n-1 1\n0 1\n1 1\n0 -0.5\n",
+            "1 2\n1 3\n1 4 strong\n1 5 soft\n",
+        ),
+        r#"[[bodies.supports]]
+nodes = [2, 3, 4]
+fix = ["x", "y"]
+[[bodies.supports]]
+nodes = [1, 5]
+fix = ["x"]
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, -0.501]
+normal = [0.0, 1.0]
+travel = [0.0, 0.03]
+[contact]
+penalty = 1e9
+"#,
+    );
+    assert!(summary.collapse.is_none() && summary.failure.is_none());
+    let (ea, fca, k, ks, gap, travel) = (2e7, 25e3, 1e9, 2e6, 1e-3, 0.03);
+    let r2 = 2f64.sqrt();
+    let lambda =
+        |big_k: f64, u: f64| (gap + big_k * u * (1.0 / k + 1.0 / ks + 1.0 / big_k)) / travel;
+    let first = lambda(ea * (1.0 + 1.0 / r2), fca / ea);
+    let second = lambda(ea / r2, 2.0 * fca / ea);
+    assert!(
+        second < 0.75 && 0.75 < first && first < 1.0,
+        "{first} {second}"
+    );
+    let breaks: Vec<(usize, usize)> = summary.breaks.iter().map(|b| (b.step, b.member)).collect();
+    assert_eq!(breaks, vec![(4, 2), (4, 1)], "{:?}", summary.breaks);
+    let (b1, b2) = (summary.breaks[0].load_factor, summary.breaks[1].load_factor);
+    assert!(close(b1, first, 1e-9), "{b1} against {first}");
+    assert!(close(b2, second, 1e-9), "{b2} against {second}");
+    let body = &step_json(d, "pushed", 4)["bodies"][0];
+    assert_eq!(body["broken"], serde_json::json!([2, 1]));
+    let k3 = ea / (2.0 * r2);
+    let press = (travel - gap) / (1.0 / k + 1.0 / ks + 1.0 / k3);
+    let forces: Vec<f64> = body["axial_forces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!((forces[0], forces[1]), (0.0, 0.0));
+    assert!(close(forces[2], -r2 * press, 1e-9), "{forces:?}");
+    assert!(close(forces[3], -press, 1e-9), "{forces:?}");
+}

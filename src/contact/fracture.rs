@@ -10,9 +10,16 @@
 //! contact is settled there, and the bracket narrowed, until the member is at its strength to
 //! [`AT_STRENGTH`]. The member breaks (or passes a tooth) at that load, contact is settled
 //! again there with the weakened body, then at the step's load, and so on until no member is
-//! beyond its strength at the step's load. Members break only at settled states. A member
-//! already beyond its strength just after a break breaks at that break's load (a snap-back
-//! below it is not followed, unlike [`BreakingEquilibrium`](crate::linkage::fracture::BreakingEquilibrium)).
+//! beyond its strength at the step's load. Members break only at settled states.
+//!
+//! Snap-backs are followed as [`BreakingEquilibrium`](crate::linkage::fracture::BreakingEquilibrium)
+//! follows them: when members beyond their strength at the step's load are, just after a
+//! break, already beyond it at the break's load, the weakened body reaches their strength at a
+//! lower load. Frictionless contact of linear bodies does not depend on the path, so contact is
+//! settled lower on the weakened body until those members are within their strength
+//! (`ContactFracture::below`), and the search runs between there and the break's state; the
+//! next break is recorded at its lower load (the fraction of the step's increment below the
+//! previous break's, below 0 when it lies in an earlier step's).
 //!
 //! A broken member keeps its place in the body with a modulus factor of zero (a softened one:
 //! its tooth's, [`Body::member_factors`]), so numbering, patterns, surfaces and the materials
@@ -163,10 +170,47 @@ impl ContactFracture {
             .collect()
     }
 
-    /// The first member to reach its strength on the secant from stresses `lo` to `hi`: (body,
-    /// member, fraction of the way), the smallest fraction, ties by body then member. Members
-    /// beyond their strength by less than [`AT_STRENGTH`] at `hi` do not count.
-    fn first_over(&self, lo: &[Vec<Real>], hi: &[Vec<Real>]) -> Option<(usize, usize, Real)> {
+    /// Per breaking body, whether each member is beyond its strength in `stress` by more than
+    /// [`AT_STRENGTH`] (intact members of a breaking material only; empty for other bodies).
+    fn beyond(&self, stress: &[Vec<Real>]) -> Vec<Vec<bool>> {
+        self.breaking
+            .iter()
+            .enumerate()
+            .map(|(b, br)| {
+                let Some(br) = br else { return Vec::new() };
+                (0..br.factor.len())
+                    .map(|m| match br.limits[m] {
+                        Some((tensile, compressive)) if br.factor[m] != 0.0 => {
+                            let s = stress[b][m];
+                            s > tensile * (1.0 + AT_STRENGTH)
+                                || s < -compressive * (1.0 + AT_STRENGTH)
+                        }
+                        _ => false,
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Whether any member of `of` (per body, as [`ContactFracture::beyond`] gives) is beyond
+    /// its strength in `stress`.
+    fn any_beyond(&self, stress: &[Vec<Real>], of: &[Vec<bool>]) -> bool {
+        self.beyond(stress)
+            .iter()
+            .zip(of)
+            .any(|(now, of)| now.iter().zip(of).any(|(&a, &b)| a && b))
+    }
+
+    /// The first member of `over` (per body, the members beyond their strength at the step's
+    /// load) to reach its strength on the secant from stresses `lo` to `hi`: (body, member,
+    /// fraction of the way), the smallest fraction, ties by body then member. Members beyond
+    /// their strength by less than [`AT_STRENGTH`] at `hi` do not count.
+    fn first_over(
+        &self,
+        lo: &[Vec<Real>],
+        hi: &[Vec<Real>],
+        over: &[Vec<bool>],
+    ) -> Option<(usize, usize, Real)> {
         let mut best: Option<(usize, usize, Real)> = None;
         for (b, br) in self.breaking.iter().enumerate() {
             let Some(br) = br else { continue };
@@ -174,7 +218,7 @@ impl ContactFracture {
                 let Some((tensile, compressive)) = br.limits[m] else {
                     continue;
                 };
-                if br.factor[m] == 0.0 {
+                if br.factor[m] == 0.0 || !over[b][m] {
                     continue;
                 }
                 let (a, end) = (lo[b][m], hi[b][m]);
@@ -192,7 +236,8 @@ impl ContactFracture {
         best
     }
 
-    /// Whether member `m` of body `b` is at its strength in `stress` to [`AT_STRENGTH`].
+    /// Whether member `m` of body `b` is at its strength (tensile or compressive) in `stress`
+    /// to [`AT_STRENGTH`].
     fn at_strength(&self, b: usize, m: usize, stress: &[Vec<Real>]) -> bool {
         let Some(br) = &self.breaking[b] else {
             return false;
@@ -200,9 +245,7 @@ impl ContactFracture {
         let Some((tensile, compressive)) = br.limits[m] else {
             return false;
         };
-        let s = stress[b][m];
-        (s - tensile).abs() <= AT_STRENGTH * tensile
-            || (s + compressive).abs() <= AT_STRENGTH * compressive
+        at_limit(stress[b][m], tensile) || at_limit(-stress[b][m], compressive)
     }
 
     /// Break member `m` of body `b`, or move it to its next tooth (returned, 1-based: the
@@ -291,11 +334,26 @@ impl ContactFracture {
         let mut fallen: Vec<Vec<FallenPiece>> = vec![Vec::new(); self.bodies.len()];
         if step > 0 {
             let end = step as Real;
+            // The search runs between a settled state where the members beyond their strength
+            // at the step's load are within it (`lo`, at `t_lo`) and one where some are (`top`):
+            // the step's end, or after a break that sent others past their strength at its
+            // load, that break's load (a snap-back: they reach it lower).
             let (mut t_lo, mut lo) = (end - 1.0, self.last.clone());
-            let mut hi = self.stresses(solver);
-            while let Some((b, m, t_break)) =
-                self.critical_load(solver, obstacles, step, steps, (t_lo, &lo), &hi)?
-            {
+            let mut at_end = self.stresses(solver);
+            let mut top = (end, at_end.clone());
+            loop {
+                let over = self.beyond(&at_end);
+                let Some((b, m, t_break)) = self.critical_load(
+                    solver,
+                    obstacles,
+                    (step, steps),
+                    (t_lo, &lo),
+                    (top.0, &top.1),
+                    &over,
+                )?
+                else {
+                    break;
+                };
                 let tooth = self.break_member(b, m);
                 events[b].push(BreakEvent {
                     member: m,
@@ -303,6 +361,7 @@ impl ContactFracture {
                     tooth,
                 });
                 // The state just after the break, at its load, then at the step's.
+                let mut after = Vec::new();
                 for t in [t_break, end] {
                     if !self.settle_or_release(
                         solver,
@@ -320,10 +379,29 @@ impl ContactFracture {
                         });
                     }
                     if t == t_break {
-                        (t_lo, lo) = (t_break, self.stresses(solver));
+                        after = self.stresses(solver);
                     }
                 }
-                hi = self.stresses(solver);
+                at_end = self.stresses(solver);
+                let over = self.beyond(&at_end);
+                if self.any_beyond(&after, &over) {
+                    (t_lo, lo) = self.below(
+                        solver,
+                        obstacles,
+                        (step, steps),
+                        (t_break, &after),
+                        &at_end,
+                        t_lo,
+                        &over,
+                    )?;
+                    top = (t_break, after);
+                } else {
+                    (t_lo, lo) = (t_break, after);
+                    top = (end, at_end.clone());
+                }
+            }
+            if self.now != end {
+                self.settle(solver, obstacles, end, (step, steps))?;
             }
             if events.iter().any(|e| !e.is_empty()) {
                 solver.restart_path();
@@ -465,48 +543,118 @@ impl ContactFracture {
             .extend(nodes.iter().map(|&n| Support::fixed(n, [true; 3])));
     }
 
-    /// The first member to reach its strength between the settled state at pseudo-time `t_lo`
-    /// (stresses `lo`, members within their strength) and the step's end (stresses `hi`, the
-    /// solver's current state): (body, member, pseudo-time), contact settled there; `None`
-    /// when every member is within its strength at the end.
+    /// A settled state below a break at `t_break` (pseudo-time; stresses `after`, the state
+    /// just after it) that sent members of `over` past their strength at its load, where,
+    /// settled with the body as it is now, every member of `over` is within its strength:
+    /// (pseudo-time, stresses). Frictionless contact of linear bodies does not depend on the
+    /// path, so settling at a lower load is as good as reaching it by unloading. Tried first
+    /// twice as far below `t_break` as the secant from `after` to the step's end (`at_end`)
+    /// puts the first crossing, then at `t_lo` (where the last search started), the step's
+    /// start and the unloaded state (pseudo-time 0). A settle that fails is retried halfway
+    /// to `t_break`. When no state is found the break's own: the member then breaks there, as
+    /// [`ContactFracture::critical_load`] does with a bracket that starts beyond the strength.
+    #[allow(clippy::too_many_arguments)]
+    fn below(
+        &mut self,
+        solver: &mut ContactSolver,
+        obstacles: &[Obstacle],
+        (step, steps): (usize, usize),
+        (t_break, after): (Real, &[Vec<Real>]),
+        at_end: &[Vec<Real>],
+        t_lo: Real,
+        over: &[Vec<bool>],
+    ) -> Result<(Real, Vec<Vec<Real>>), FractureStop> {
+        let end = step as Real;
+        let mut first: Option<Real> = None;
+        for (b, br) in self.breaking.iter().enumerate() {
+            let Some(br) = br else { continue };
+            for (m, limits) in br.limits.iter().enumerate() {
+                let Some((tensile, compressive)) = *limits else {
+                    continue;
+                };
+                let (a, z) = (after[b][m], at_end[b][m]);
+                if !over[b][m] || (a <= tensile && a >= -compressive) {
+                    continue;
+                }
+                if let Some(f) = critical_fraction(a, z - a, tensile, compressive) {
+                    first = Some(first.map_or(f, |g: Real| g.min(f)));
+                }
+            }
+        }
+        let mut t = match first {
+            Some(f) if end > t_break && f < 0.0 => (t_break + 2.0 * f * (end - t_break)).max(0.0),
+            _ if t_lo < t_break => t_lo,
+            _ => end - 1.0,
+        };
+        let mut failures = 0;
+        while t < t_break && t >= 0.0 {
+            let saved = solver.converged_state();
+            let from = self.now;
+            if self.settle(solver, obstacles, t, (step, steps)).is_err() {
+                solver.restore(saved);
+                self.now = from;
+                failures += 1;
+                if failures > 6 {
+                    break;
+                }
+                t = 0.5 * (t + t_break);
+                continue;
+            }
+            let stress = self.stresses(solver);
+            if !self.any_beyond(&stress, over) {
+                return Ok((t, stress));
+            }
+            match [t_lo, end - 1.0, 0.0].into_iter().find(|&lower| lower < t) {
+                Some(lower) => t = lower,
+                None => break,
+            }
+        }
+        Ok((t_break, after.to_vec()))
+    }
+
+    /// The first member of `over` (per body: beyond its strength at the step's load) to reach
+    /// its strength between the settled state at pseudo-time `t_lo` (stresses `lo`, those
+    /// members within their strength) and the one at `t_hi` (stresses `hi`): (body, member,
+    /// pseudo-time), contact settled there; `None` when no member of `over` is beyond its
+    /// strength at `t_hi`.
     #[allow(clippy::type_complexity)]
     fn critical_load(
         &mut self,
         solver: &mut ContactSolver,
         obstacles: &[Obstacle],
-        step: usize,
-        steps: usize,
+        (step, steps): (usize, usize),
         (t_lo, lo): (Real, &[Vec<Real>]),
-        hi: &[Vec<Real>],
+        (t_hi, hi): (Real, &[Vec<Real>]),
+        over: &[Vec<bool>],
     ) -> Result<Option<(usize, usize, Real)>, FractureStop> {
         let end = step as Real;
         let (mut t_lo, mut lo) = (t_lo, lo.to_vec());
-        let (mut t_hi, mut hi) = (end, hi.to_vec());
-        let Some(mut found) = self.first_over(&lo, &hi) else {
+        let (mut t_hi, mut hi) = (t_hi, hi.to_vec());
+        let Some(mut found) = self.first_over(&lo, &hi, over) else {
             return Ok(None);
         };
         for _ in 0..MAX_REFINEMENTS {
             let (b, m, f) = found;
             if f <= 0.0 {
-                // Beyond its strength already where the bracket starts (just after a break).
+                // Beyond its strength already where the bracket starts.
                 self.settle(solver, obstacles, t_lo, (step, steps))?;
                 return Ok(Some((b, m, t_lo)));
             }
             let t = t_lo + f.min(1.0) * (t_hi - t_lo);
             self.settle(solver, obstacles, t, (step, steps))?;
             let at = self.stresses(solver);
-            match self.first_over(&lo, &at) {
+            match self.first_over(&lo, &at, over) {
                 // Someone beyond its strength at t: the crossing is before it.
                 Some(next) if !self.at_strength(next.0, next.1, &at) => {
                     (t_hi, hi) = (t, at);
-                    found = self.first_over(&lo, &hi).unwrap_or(next);
+                    found = self.first_over(&lo, &hi, over).unwrap_or(next);
                 }
                 _ if self.at_strength(b, m, &at) || t_hi - t_lo <= 1e-12 * end.max(1.0) => {
                     return Ok(Some((b, m, t)));
                 }
                 _ => {
                     (t_lo, lo) = (t, at);
-                    match self.first_over(&lo, &hi) {
+                    match self.first_over(&lo, &hi, over) {
                         Some(next) => found = next,
                         None => {
                             self.settle(solver, obstacles, t_hi, (step, steps))?;
@@ -520,6 +668,12 @@ impl ContactFracture {
         self.settle(solver, obstacles, t_hi, (step, steps))?;
         Ok(Some((b, m, t_hi)))
     }
+}
+
+/// Whether `stress` (Pa) is at `limit` (Pa, positive; infinite: none) to [`AT_STRENGTH`]. A
+/// missing strength is never reached: `∞ − s` compared with `AT_STRENGTH · ∞` would be.
+fn at_limit(stress: Real, limit: Real) -> bool {
+    limit.is_finite() && (stress - limit).abs() <= AT_STRENGTH * limit
 }
 
 /// Give the solver body `b`'s supports anew (nodes removed or given back): its DOF map, its
