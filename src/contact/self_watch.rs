@@ -155,6 +155,8 @@ impl SelfContactWatch {
                 .into_iter()
                 .collect(),
             Target::Closing { member, .. } => self.body[0].members[member].nodes.to_vec(),
+            Target::Edge { nodes, .. } => nodes.to_vec(),
+            Target::Corner { node, .. } => vec![node],
             Target::Obstacle(_) | Target::Sharp { .. } => Vec::new(),
         }
     }
