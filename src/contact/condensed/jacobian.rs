@@ -646,6 +646,21 @@ mod tests {
     use super::*;
     use nalgebra::{DMatrix, DVector};
 
+    /// Two contacts' `G C Gᵀ` (symmetric positive definite), their stick stiffnesses
+    /// (k_n, k_t, k_t) per contact, a slipping block (k_n along the normal x, unsymmetric,
+    /// singular along y) and a right-hand side.
+    fn two_contacts() -> (DMatrix<Real>, [Real; 6], Matrix3<Real>, DVector<Real>) {
+        let b = DMatrix::<Real>::from_fn(6, 6, |i, j| {
+            ((i * 7 + j * 3) % 5) as Real * 0.1 + if i == j { 0.5 } else { 0.0 }
+        });
+        (
+            &b * b.transpose(),
+            [4.0, 2.0, 2.0, 5.0, 3.0, 3.0],
+            Matrix3::new(5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.5, 0.0, 0.8),
+            DVector::from_vec(vec![1.0, -2.0, 0.5, 3.0, -1.0, 2.0]),
+        )
+    }
+
     /// Rows of two contacts of three rows each along x, y, z, with stick stiffnesses `r`
     /// and each contact's slipping block (`None`: sticking).
     fn rows(r: &[Real; 6], slipping: [Option<Matrix3<Real>>; 2]) -> Vec<ContactRow> {
@@ -691,13 +706,7 @@ mod tests {
         // The matrices of the test below; the factor made with the second contact slipping,
         // approximately: its reference is its block's diagonal (5, ~0, 0.8), the coupling 1.5
         // of its normal into its third row left out.
-        let b = DMatrix::<Real>::from_fn(6, 6, |i, j| {
-            ((i * 7 + j * 3) % 5) as Real * 0.1 + if i == j { 0.5 } else { 0.0 }
-        });
-        let a = &b * b.transpose();
-        let r = [4.0, 2.0, 2.0, 5.0, 3.0, 3.0];
-        let slip = Matrix3::new(5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.5, 0.0, 0.8);
-        let x = DVector::from_vec(vec![1.0, -2.0, 0.5, 3.0, -1.0, 2.0]);
+        let (a, r, slip, x) = two_contacts();
         let at_factor = rows(&r, [None, Some(slip)]);
         let reference = reference_stiffness(&at_factor, false);
         let expected_reference = [4.0, 2.0, 2.0, 5.0, SLIP_REFERENCE * 3.0, 0.8];
@@ -739,13 +748,7 @@ mod tests {
     fn the_schur_complement_on_slipping_rows_solves_the_whole_unsymmetric_jacobian() {
         // A symmetric positive definite G C Gᵀ, stick stiffnesses (k_n, k_t, k_t) per contact
         // and a slipping block: k_n along the normal (x), unsymmetric, singular along y.
-        let b = DMatrix::<Real>::from_fn(6, 6, |i, j| {
-            ((i * 7 + j * 3) % 5) as Real * 0.1 + if i == j { 0.5 } else { 0.0 }
-        });
-        let a = &b * b.transpose();
-        let r = [4.0, 2.0, 2.0, 5.0, 3.0, 3.0];
-        let slip = Matrix3::new(5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.5, 0.0, 0.8);
-        let x = DVector::from_vec(vec![1.0, -2.0, 0.5, 3.0, -1.0, 2.0]);
+        let (a, r, slip, x) = two_contacts();
         let mut f = Mat::<Real>::zeros(6, 6);
         for i in 0..6 {
             for j in 0..6 {
