@@ -28,6 +28,9 @@ pub(crate) fn bench_fracture(cells: Vec<[usize; 3]>, breaks: Option<usize>) -> R
     let t = linkage::bench::fracture::measure_fracture(cells, breaks, 10)
         .map_err(anyhow::Error::msg)?;
     println!("{}", linkage::bench::fracture::format_fracture(&t));
+    let split =
+        linkage::bench::fracture::measure_solve_split(cells, 20).map_err(anyhow::Error::msg)?;
+    println!("{}", linkage::bench::fracture::format_solve_split(&split));
     Ok(())
 }
 

@@ -44,6 +44,14 @@ pub struct FractureTiming {
     /// Whether both ways broke the same members in the same order, at load fractions equal
     /// to 1e-9.
     pub same_sequence: bool,
+    /// Of the breaks' time: solves and Woodbury corrections (the removals and the load
+    /// pattern's re-solve after each refactorization), s.
+    pub break_solve_seconds: Real,
+    /// Of the breaks' time: refactorizations (numeric), s.
+    pub refactor_numeric_seconds: Real,
+    /// Of the solves, when breaks are taken in the factor's space: the sparse forward solves
+    /// and the backward solves, s.
+    pub factor_space_seconds: Option<(Real, Real)>,
     /// Peak resident memory of the process, bytes.
     pub peak_memory: u64,
 }
@@ -108,6 +116,9 @@ pub fn measure_fracture(
         }
     }
     let breaking = t.elapsed().as_secs_f64();
+    let break_solve = eq.times.solve - solve;
+    let refactor_numeric = eq.times.numeric - factor;
+    let factor_space = eq.factor_space_seconds();
     let mean_factor = eq.times.numeric / eq.factorizations.max(1) as Real;
     let refactorizations = eq.factorizations - 1;
     let refactor_every = eq.refactor_every;
@@ -145,18 +156,148 @@ pub fn measure_fracture(
         compared_breaks: compared,
         refactor_seconds_per_break: refactor_per_break,
         same_sequence: same,
+        break_solve_seconds: break_solve,
+        refactor_numeric_seconds: refactor_numeric,
+        factor_space_seconds: factor_space,
         peak_memory: peak_memory(),
     })
+}
+
+/// The solves of one break in the factor's space against a full solve with the same factor,
+/// timed side by side (the least of the repetitions, alternating: the least disturbed by
+/// other work on the machine), s.
+#[derive(Clone, Debug)]
+pub struct SolveSplit {
+    /// Entries of the factor's values (faer's supernodal storage).
+    pub factor_values: usize,
+    /// Rows of the sparse forward solve's result (of n).
+    pub reach_rows: usize,
+    /// A full solve (faer: forward and backward).
+    pub full: Real,
+    /// The sparse forward solve of one member's six entries.
+    pub forward_sparse: Real,
+    /// One backward solve, subtrees side by side.
+    pub backward: Real,
+    /// One backward solve on one thread.
+    pub backward_one_thread: Real,
+    /// faer's backward solve (`l_transpose_solve`, one thread), for comparison.
+    pub faer_backward: Real,
+}
+
+/// Time [`SolveSplit`] on the intact lattice of `cells`, `reps` times each.
+pub fn measure_solve_split(cells: [usize; 3], reps: usize) -> Result<SolveSplit, String> {
+    use crate::linalg::tree_solve::{ReachWork, SupernodalSolver};
+    use crate::linalg::SparseCholesky;
+    use crate::linkage::{linear_member_block, DofMap, StiffnessAssembly};
+    let (body, _) = fracture_lattice(cells)?;
+    let dofs = DofMap::new(&body);
+    let asm = StiffnessAssembly::new(&body, &dofs).map_err(|e| e.to_string())?;
+    let mut values = Vec::new();
+    asm.fill(&body, |m| linear_member_block(&body, m), &mut values);
+    let mut chol = SparseCholesky::analyze(asm.n, &asm.col_ptr, &asm.row_idx, Some(&asm.groups))
+        .map_err(|e| e.to_string())?;
+    chol.factorize(&values).map_err(|e| e.to_string())?;
+    let solver = SupernodalSolver::new(&chol).ok_or("the factor is not supernodal and large")?;
+    let n = asm.n;
+    // A member in the middle of the lattice: its nodes' free DOFs, unit axis along x.
+    let m = body.members.len() / 2;
+    let mut g = Vec::new();
+    for (sign, &node) in [-1.0, 1.0].iter().zip(&body.members[m].nodes) {
+        for dir in 0..3 {
+            if let Some(i) = dofs.free_index(node, dir) {
+                g.push((i, sign * if dir == 0 { 1.0 } else { 0.5 }));
+            }
+        }
+    }
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let mut work = ReachWork::default();
+    let mut x = vec![0.0; n];
+    let mut rhs = vec![0.0; n];
+    let inf = Real::INFINITY;
+    let (mut full, mut fwd, mut bwd, mut bwd1, mut reach) = (inf, inf, inf, inf, 0);
+    let mut fb = inf;
+    let mut mem = faer::dyn_stack::MemBuffer::new(
+        chol.supernodal_symbolic()
+            .ok_or("not supernodal")?
+            .solve_in_place_scratch::<f64>(1, faer::Par::Seq),
+    );
+    for _ in 0..reps.max(1) {
+        rhs.fill(1.0);
+        let t = Instant::now();
+        chol.solve_in_place(&mut rhs);
+        full = full.min(t.elapsed().as_secs_f64());
+        let l = chol.factor_values().ok_or("not factored")?;
+        x.fill(0.0);
+        let t = Instant::now();
+        let z = solver.forward_sparse(l, &g, &mut x, &mut work);
+        fwd = fwd.min(t.elapsed().as_secs_f64());
+        reach = z.rows.len();
+        let mut y = x.clone();
+        let t = Instant::now();
+        solver.backward(l, &mut x);
+        bwd = bwd.min(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        one.install(|| solver.backward(l, &mut y));
+        bwd1 = bwd1.min(t.elapsed().as_secs_f64());
+        let sym = chol.supernodal_symbolic().ok_or("not supernodal")?;
+        let t = Instant::now();
+        faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef::new(sym, l)
+            .l_transpose_solve_with_conj(
+                faer::Conj::No,
+                faer::MatMut::from_column_major_slice_mut(&mut y, n, 1),
+                faer::Par::Seq,
+                faer::dyn_stack::MemStack::new(&mut mem),
+            );
+        fb = fb.min(t.elapsed().as_secs_f64());
+    }
+    Ok(SolveSplit {
+        factor_values: chol.stats().factor_values,
+        reach_rows: reach,
+        full,
+        forward_sparse: fwd,
+        backward: bwd,
+        backward_one_thread: bwd1,
+        faer_backward: fb,
+    })
+}
+
+/// One line for [`SolveSplit`].
+pub fn format_solve_split(s: &SolveSplit) -> String {
+    format!(
+        "a break's solves, side by side with a full solve (factor of {:.1} M values): full solve {:.4} s; \
+         sparse forward {:.4} s ({} rows reached); backward {:.4} s (one thread {:.4} s; faer's {:.4} s): {:.2} of a full solve",
+        s.factor_values as f64 / 1e6,
+        s.full,
+        s.forward_sparse,
+        s.reach_rows,
+        s.backward,
+        s.backward_one_thread,
+        s.faer_backward,
+        (s.forward_sparse + s.backward) / s.full.max(1e-12)
+    )
 }
 
 /// The benchmark's table, one quantity a line.
 pub fn format_fracture(t: &FractureTiming) -> String {
     let per_break = t.breaking_seconds / t.breaks.max(1) as Real;
     let refactor_total = t.refactor_seconds_per_break * t.breaks as Real;
+    let split = match t.factor_space_seconds {
+        Some((f, b)) => format!(
+            " (of which sparse forward solves {f:.2} s, backward solves {b:.2} s: {:.4} + {:.4} s a break)",
+            f / t.breaks.max(1) as Real,
+            b / t.breaks.max(1) as Real
+        ),
+        None => String::new(),
+    };
+    let rest = t.breaking_seconds - t.break_solve_seconds - t.refactor_numeric_seconds;
     format!(
         "lattice {}x{}x{} cells: {} nodes, {} members, {} free DOFs\n\
          ordering + symbolic {:.3} s; one factorization {:.3} s (the run's mean {:.3} s); one solve {:.4} s\n\
          {} breaks with the factor kept (Woodbury, refactored every {} breaks: {} refactorizations): {:.2} s, {:.4} s a break = {:.1} factorizations' worth (of the mean; {:.1} of the first)\n\
+         of which: solves and corrections {:.2} s{}, refactorizations {:.2} s, search and the rest {:.2} s\n\
          refactoring at every break: {:.3} s a break (measured over the first {}), so {:.1} s for {} breaks: {:.1}x slower\n\
          same members in the same order, fractions equal to 1e-9: {}\n\
          peak memory {:.0} MB",
@@ -177,6 +318,10 @@ pub fn format_fracture(t: &FractureTiming) -> String {
         per_break,
         t.breaking_seconds / t.mean_factor_seconds.max(1e-12),
         t.breaking_seconds / t.factor_seconds.max(1e-12),
+        t.break_solve_seconds,
+        split,
+        t.refactor_numeric_seconds,
+        rest,
         t.refactor_seconds_per_break,
         t.compared_breaks,
         refactor_total,

@@ -5,6 +5,7 @@ use std::fmt;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
     SymbolicCholeskyRaw, SymmetricOrdering,
@@ -480,6 +481,20 @@ impl SparseCholesky {
     /// factor column `new`).
     pub fn permutation(&self) -> &[usize] {
         &self.perm
+    }
+
+    /// The supernodal structure of the factor (`None` when simplicial), for solves that walk
+    /// it ([`SupernodalSolver`](super::tree_solve::SupernodalSolver)).
+    pub(crate) fn supernodal_symbolic(&self) -> Option<&SymbolicSupernodalCholesky<usize>> {
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => Some(s),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        }
+    }
+
+    /// The factor's values in faer's storage, `None` unless the last factorization succeeded.
+    pub(crate) fn factor_values(&self) -> Option<&[f64]> {
+        self.factorized.then_some(&self.l_values[..])
     }
 
     /// Smallest accepted pivot ratio `d_j / A_jj` (dimensionless).

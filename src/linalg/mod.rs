@@ -6,7 +6,9 @@ pub use self::block_jacobi::{BlockJacobi, SingularBlock};
 pub use self::cholesky::{CholeskyError, SparseCholesky};
 pub use self::conjugate_gradient::{conjugate_gradient, CgReport, CgSettings, Preconditioner};
 pub use self::ldlt::SparseLdlt;
-pub use self::low_rank::{LowRankCorrection, LowRankUpdate, Removal, SingularUpdate, SparseColumn};
+pub use self::low_rank::{
+    FactorLowRankUpdate, LowRankCorrection, LowRankUpdate, Removal, SingularUpdate, SparseColumn,
+};
 pub use self::multigrid::{MultigridError, SmoothedAggregation};
 pub use self::symmetric_csr::{dot, SymmetricCsr};
 
@@ -20,3 +22,4 @@ pub mod multigrid;
 pub mod ordering;
 mod symmetric_csr;
 mod tree_cholesky;
+pub mod tree_solve;

@@ -11,12 +11,19 @@
 //! `w = K⁻¹ g`, `s = 1/k − gᵀ w`), so a break costs one solve with the factor, not a solve per
 //! pattern.
 //!
+//! On a large supernodal factor (20,000 free DOFs or more) the update is kept in the factor's
+//! space instead ([`FactorLowRankUpdate`]): `L⁻¹ P g` is nonzero only on the paths from the
+//! member's two nodes to the root of the elimination tree, so a break costs a forward solve
+//! over those paths, sparse products with the earlier breaks' columns and one backward solve
+//! (independent subtrees side by side, the same bits on any number of threads), about half a
+//! full solve on the benchmark lattice (docs/PERFORMANCE.md, "Fracture").
+//!
 //! A softening member (its material's `softening`, see [`saw_tooth`]) passes through its
 //! teeth the same way: each tooth is an event found like a break, and the drop of its
 //! stiffness from `kᵢ` to `kᵢ₊₁` is the rank-one removal of `(kᵢ − kᵢ₊₁) g gᵀ`; the last tooth
 //! breaks it.
 
-use crate::linalg::{CholeskyError, LowRankUpdate, SparseCholesky};
+use crate::linalg::{CholeskyError, FactorLowRankUpdate, LowRankUpdate, SparseCholesky};
 use crate::linkage::body_state::{linear_internal_forces, linear_stretch, undeformed_axis};
 use crate::linkage::fracture::{
     critical_fraction, member_limits, released_pieces, saw_tooth, BreakEvent, FallenPiece,
@@ -67,6 +74,10 @@ pub struct BreakingEquilibrium {
     values: Vec<Real>,
     cholesky: Option<SparseCholesky>,
     update: LowRankUpdate,
+    /// The update in the factor's space, used instead of `update` for large supernodal
+    /// factors: a break then costs a forward solve over its two nodes' paths in the
+    /// elimination tree and one backward solve, not a full solve and `O(n r)`.
+    factor_update: Option<FactorLowRankUpdate>,
     /// Per member its current `A Eᵢ / L`, N/m; 0 once broken or fallen off.
     stiffness: Vec<Real>,
     /// Per member `A E / L` of its material, N/m.
@@ -135,6 +146,7 @@ impl BreakingEquilibrium {
             values: Vec::new(),
             cholesky: None,
             update: LowRankUpdate::new(n, SINGULAR_RATIO),
+            factor_update: None,
             full_stiffness: stiffness.clone(),
             stiffness,
             modulus_factor: vec![1.0; body.members.len()],
@@ -158,6 +170,7 @@ impl BreakingEquilibrium {
             let c = SparseCholesky::analyze(a.n, &a.col_ptr, &a.row_idx, Some(&a.groups))
                 .map_err(|e| factorization_error(body, e))?;
             eq.times.symbolic = t.elapsed().as_secs_f64();
+            eq.factor_update = FactorLowRankUpdate::new(&c, SINGULAR_RATIO);
             eq.cholesky = Some(c);
             if let Err(e) = eq.factorize() {
                 return Err(eq.singular(body, e));
@@ -180,6 +193,28 @@ impl BreakingEquilibrium {
         eq.patterns = patterns.unwrap_or_default();
         eq.times.solve += t.elapsed().as_secs_f64();
         Ok(eq)
+    }
+
+    /// Rank-one changes taken into the solves since the last factorization.
+    fn rank(&self) -> usize {
+        match &self.factor_update {
+            Some(u) => u.rank(),
+            None => self.update.rank(),
+        }
+    }
+
+    /// Whether breaks are taken in the factor's space ([`FactorLowRankUpdate`]: large
+    /// supernodal factors) rather than by full solves.
+    pub fn updates_in_factor_space(&self) -> bool {
+        self.factor_update.is_some()
+    }
+
+    /// Time in the sparse forward and in the backward solves of breaks, s, when they are taken
+    /// in the factor's space.
+    pub fn factor_space_seconds(&self) -> Option<(Real, Real)> {
+        self.factor_update
+            .as_ref()
+            .map(|u| (u.forward_seconds, u.backward_seconds))
     }
 
     /// Members broken so far, 0-based, in order.
@@ -233,6 +268,9 @@ impl BreakingEquilibrium {
         self.times.numeric += t.elapsed().as_secs_f64();
         self.factorizations += 1;
         self.update.clear();
+        if let Some(u) = self.factor_update.as_mut() {
+            u.clear();
+        }
         result
     }
 
@@ -406,8 +444,9 @@ impl BreakingEquilibrium {
         }
         let passed = softened.map(|_| next);
         let t = Instant::now();
-        let removal = match self.cholesky.as_mut() {
-            Some(c) if !g.is_empty() => self
+        let removal = match (self.cholesky.as_mut(), self.factor_update.as_mut()) {
+            (Some(c), Some(u)) if !g.is_empty() => u.remove(c, &g, k).map(Some),
+            (Some(c), None) if !g.is_empty() => self
                 .update
                 .remove(&mut |x| c.solve_in_place(x), &g, k)
                 .map(Some),
@@ -423,7 +462,7 @@ impl BreakingEquilibrium {
                         p.displacements[dof] += coef * r.w[i];
                     }
                 }
-                if self.update.rank() >= self.refactor_every && !self.refactor(body) {
+                if self.rank() >= self.refactor_every && !self.refactor(body) {
                     return Err(());
                 }
                 Ok((passed, Vec::new()))
