@@ -14,10 +14,11 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 use rayon::iter::ParallelExtend;
+use std::sync::atomic::{AtomicBool, Ordering as AtomicOrdering};
 
 use super::ordering::{
-    expand_to_dofs, graph_of_pattern, nested_dissection, nested_dissection_with_trailing,
-    OrderingError,
+    expand_to_dofs, factor_entries, graph_of_pattern, nested_dissection,
+    nested_dissection_with_trailing, OrderingError,
 };
 use super::tree_cholesky::{postorder, TreePlan, MIN_TREE_DOFS};
 
@@ -158,6 +159,8 @@ pub struct SparseCholesky {
     pivot_tolerance: f64,
     ordering: FillOrdering,
     factorized: bool,
+    /// `l_values` holds only zeros (nothing factored into it since the analysis).
+    l_zero: bool,
 }
 
 impl fmt::Debug for SparseCholesky {
@@ -215,13 +218,39 @@ impl SparseCholesky {
                 let (node_perm, node_inv) = nested_dissection(&xadj, &adjncy)?;
                 let (perm, inv) = match groups {
                     Some(g) => expand_to_dofs(&node_perm, g)?,
-                    None => (node_perm, node_inv),
+                    None => (node_perm.clone(), node_inv.clone()),
                 };
-                Some(if tree_parallel {
-                    postorder(col_ptr, row_idx, &perm, &inv)
-                } else {
-                    (perm, inv)
-                })
+                if tree_parallel {
+                    // The factor's pages are faulted in on the other core while the ordering
+                    // is postordered and analysed (the first touch of a 2 GB factor takes
+                    // about as long as the analysis itself), up to its size as the node
+                    // graph gives it.
+                    let mut sizes = vec![0usize; n_nodes];
+                    match groups {
+                        Some(g) => g.iter().for_each(|&node| sizes[node] += 1),
+                        None => sizes.fill(1),
+                    }
+                    let done = AtomicBool::new(false);
+                    let (early, analysed) = rayon::join(
+                        || {
+                            let entries =
+                                factor_entries(&xadj, &adjncy, &node_perm, &node_inv, &sizes);
+                            prefault(entries, &done)
+                        },
+                        || {
+                            let custom = postorder(col_ptr, row_idx, &perm, &inv);
+                            let analysed =
+                                symbolic_analysis(n, col_ptr, row_idx, Some(custom), options);
+                            done.store(true, AtomicOrdering::Relaxed);
+                            analysed
+                        },
+                    );
+                    let (pattern, symbolic) = analysed?;
+                    return Self::from_symbolic(
+                        n, col_ptr, row_idx, pattern, symbolic, options, true, early,
+                    );
+                }
+                Some((perm, inv))
             }
             // faer 0.24's `SymmetricOrdering::Identity` skips the conversion to the upper
             // triangle its symbolic analysis reads, so a lower-triangle input gets a wrong
@@ -230,7 +259,17 @@ impl SparseCholesky {
             FillOrdering::Identity => Some(((0..n).collect(), (0..n).collect())),
             FillOrdering::Amd => None,
         };
-        Self::analyze_ordered(n, col_ptr, row_idx, custom, options, tree_parallel)
+        let (pattern, symbolic) = symbolic_analysis(n, col_ptr, row_idx, custom, options)?;
+        Self::from_symbolic(
+            n,
+            col_ptr,
+            row_idx,
+            pattern,
+            symbolic,
+            options,
+            false,
+            Vec::new(),
+        )
     }
 
     /// Symbolic analysis with the DOFs of the nodes marked `trailing` (`trailing[node]`,
@@ -261,37 +300,33 @@ impl SparseCholesky {
             layout: FactorLayout::Supernodal,
             threads,
         };
-        Self::analyze_ordered(n, col_ptr, row_idx, custom, options, false)
+        let (pattern, symbolic) = symbolic_analysis(n, col_ptr, row_idx, custom, options)?;
+        Self::from_symbolic(
+            n,
+            col_ptr,
+            row_idx,
+            pattern,
+            symbolic,
+            options,
+            false,
+            Vec::new(),
+        )
     }
 
-    /// The symbolic analysis proper, with `custom = Some((perm, inv))` or AMD;
-    /// `tree_parallel`: the ordering was postordered for the tree-parallel factorization.
-    fn analyze_ordered(
+    /// The solver for a finished symbolic analysis: the factor's buffer (continuing `early`,
+    /// zeros already faulted in, see [`prefault`]), the workspace and, where `tree_parallel`
+    /// (the ordering was postordered for it), the tree plan.
+    #[allow(clippy::too_many_arguments)]
+    fn from_symbolic(
         n: usize,
         col_ptr: &[usize],
         row_idx: &[usize],
-        custom: Option<(Vec<usize>, Vec<usize>)>,
+        pattern: SymbolicSparseColMat<usize>,
+        symbolic: SymbolicCholesky<usize>,
         options: CholeskyOptions,
         tree_parallel: bool,
+        early: Vec<f64>,
     ) -> Result<Self, CholeskyError> {
-        let ordering = match &custom {
-            Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
-            None => SymmetricOrdering::Amd,
-        };
-
-        let pattern =
-            SymbolicSparseColMat::new_checked(n, n, col_ptr.to_vec(), None, row_idx.to_vec());
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: match options.layout {
-                FactorLayout::Auto => SupernodalThreshold::AUTO,
-                FactorLayout::Simplicial => SupernodalThreshold::FORCE_SIMPLICIAL,
-                FactorLayout::Supernodal => SupernodalThreshold::FORCE_SUPERNODAL,
-            },
-            ..Default::default()
-        };
-        let symbolic = factorize_symbolic_cholesky(pattern.as_ref(), Side::Lower, ordering, params)
-            .map_err(|e| CholeskyError::Resources(format!("symbolic factorization: {e:?}")))?;
-
         let perm: Vec<usize> = match symbolic.perm() {
             Some(p) => p.arrays().0.to_vec(),
             None => (0..n).collect(),
@@ -313,7 +348,7 @@ impl SparseCholesky {
         })?;
         // The factor's first touch (page faults) and the tree plan side by side.
         let (l_values, tree) = rayon::join(
-            || zeroed(symbolic.len_val()),
+            || zeroed(early, symbolic.len_val()),
             || match (symbolic.raw(), par) {
                 (SymbolicCholeskyRaw::Supernodal(s), Par::Rayon(t))
                     if tree_parallel && t.get() > 1 =>
@@ -328,7 +363,6 @@ impl SparseCholesky {
             },
         );
         let l_values = l_values?;
-
         Ok(Self {
             n,
             pattern,
@@ -343,6 +377,7 @@ impl SparseCholesky {
             pivot_tolerance: DEFAULT_PIVOT_TOLERANCE,
             ordering: options.ordering,
             factorized: false,
+            l_zero: true,
         })
     }
 
@@ -371,7 +406,8 @@ impl SparseCholesky {
             )));
         }
         if let Some(plan) = &self.tree {
-            if let Err(col) = plan.factorize(values, &mut self.l_values, self.par) {
+            let zeroed = std::mem::replace(&mut self.l_zero, false);
+            if let Err(col) = plan.factorize(values, &mut self.l_values, self.par, zeroed) {
                 return Err(CholeskyError::NonPositivePivot {
                     dof: self.perm[col.min(self.n - 1)],
                 });
@@ -405,6 +441,7 @@ impl SparseCholesky {
     /// Use faer's own sequential supernode loop from now on (for comparisons).
     pub fn disable_tree_parallel(&mut self) {
         self.tree = None;
+        self.l_zero = false;
         self.factorized = false;
     }
 
@@ -569,6 +606,35 @@ impl SparseCholesky {
     }
 }
 
+/// Pattern (a copy of A's lower CSC) and faer's symbolic analysis with `custom =
+/// Some((perm, inv))` or AMD, in the layout `options` asks for.
+fn symbolic_analysis(
+    n: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    custom: Option<(Vec<usize>, Vec<usize>)>,
+    options: CholeskyOptions,
+) -> Result<(SymbolicSparseColMat<usize>, SymbolicCholesky<usize>), CholeskyError> {
+    let ordering = match &custom {
+        Some((fwd, inv)) => SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, n)),
+        None => SymmetricOrdering::Amd,
+    };
+
+    let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr.to_vec(), None, row_idx.to_vec());
+    let params = CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: match options.layout {
+            FactorLayout::Auto => SupernodalThreshold::AUTO,
+            FactorLayout::Simplicial => SupernodalThreshold::FORCE_SIMPLICIAL,
+            FactorLayout::Supernodal => SupernodalThreshold::FORCE_SUPERNODAL,
+        },
+        ..Default::default()
+    };
+    let symbolic = factorize_symbolic_cholesky(pattern.as_ref(), Side::Lower, ordering, params)
+        .map_err(|e| CholeskyError::Resources(format!("symbolic factorization: {e:?}")))?;
+
+    Ok((pattern, symbolic))
+}
+
 /// Checks a lower-triangle CSC pattern: offsets, sorted rows in range, diagonal first.
 fn check_lower_pattern(
     n: usize,
@@ -642,16 +708,42 @@ pub(crate) fn factor_diagonal_positions(symbolic: &SymbolicCholesky<usize>) -> V
     }
 }
 
-/// A zeroed buffer, allocated fallibly and first touched in parallel: for a large
-/// factor (2.3 GB at 200k DOFs) the page faults of the first write cost seconds on one
-/// thread, and the factorization would otherwise take them all on its first call.
-fn zeroed(len: usize) -> Result<Vec<f64>, CholeskyError> {
+/// Values faulted in ahead of the factor per step of [`prefault`] (2 MB).
+const PREFAULT_CHUNK: usize = 1 << 18;
+
+/// Up to `len` zeros, allocated fallibly and written (first touched) in steps until `done`
+/// is set: run on an idle core while the analysis that fixes the factor's size goes on, and
+/// continued by [`zeroed`]. On an allocation failure returns what it has (nothing): the
+/// factor's own allocation reports the error.
+fn prefault(len: usize, done: &AtomicBool) -> Vec<f64> {
     let mut v = Vec::new();
-    v.try_reserve_exact(len)
+    if v.try_reserve_exact(len).is_err() {
+        return v;
+    }
+    while v.len() < len && !done.load(AtomicOrdering::Relaxed) {
+        let step = PREFAULT_CHUNK.min(len - v.len());
+        v.extend(std::iter::repeat_n(0.0, step));
+    }
+    v
+}
+
+/// `start` (zeros) continued to `len` zeros, allocated fallibly and first touched in
+/// parallel: for a large factor (2.3 GB at 200k DOFs) the page faults of the first write
+/// cost seconds on one thread, and the factorization would otherwise take them all on its
+/// first call.
+fn zeroed(mut start: Vec<f64>, len: usize) -> Result<Vec<f64>, CholeskyError> {
+    if start.len() >= len {
+        start.truncate(len);
+        start.shrink_to_fit();
+        return Ok(start);
+    }
+    start
+        .try_reserve_exact(len - start.len())
         .map_err(|_| CholeskyError::Resources(format!("factor of {len} values")))?;
     // Fills the reserved capacity in place (no reallocation).
-    v.par_extend(rayon::iter::repeat_n(0.0, len));
-    Ok(v)
+    let rest = len - start.len();
+    start.par_extend(rayon::iter::repeat_n(0.0, rest));
+    Ok(start)
 }
 
 #[cfg(test)]
@@ -1080,6 +1172,43 @@ mod tests {
             chol.factorize(&nan),
             Err(CholeskyError::InvalidInput(_))
         ));
+    }
+
+    /// The factor's size from the node graph ([`factor_entries`]) is exact for a lattice,
+    /// whose coupled nodes couple in all their DOFs, with supported nodes of 0 DOFs.
+    #[test]
+    fn node_graph_gives_the_factor_size() {
+        let (s, _) = crate::bench::cholmod::lattice_system([4, 3, 5]).unwrap();
+        let groups = s.groups.clone().unwrap();
+        let options = CholeskyOptions {
+            layout: FactorLayout::Simplicial,
+            threads: 1,
+            ..Default::default()
+        };
+        let chol =
+            SparseCholesky::analyze_with(s.n, &s.col_ptr, &s.row_idx, Some(&groups), options)
+                .unwrap();
+        let n_nodes = groups.iter().max().unwrap() + 1;
+        let (x, a) = graph_of_pattern(s.n, &s.col_ptr, &s.row_idx, Some(&groups), n_nodes).unwrap();
+        let (perm, inv) = nested_dissection(&x, &a).unwrap();
+        let mut sizes = vec![0; n_nodes];
+        groups.iter().for_each(|&g| sizes[g] += 1);
+        assert_eq!(
+            factor_entries(&x, &a, &perm, &inv, &sizes),
+            chol.stats().nnz_l
+        );
+    }
+
+    #[test]
+    fn zeroed_continues_or_cuts_a_prefaulted_start() {
+        let longer = zeroed(vec![0.0; 3], 10).unwrap();
+        assert_eq!(longer, vec![0.0; 10]);
+        let shorter = zeroed(vec![0.0; 10], 4).unwrap();
+        assert_eq!(shorter, vec![0.0; 4]);
+        let done = AtomicBool::new(false);
+        assert_eq!(prefault(5, &done), vec![0.0; 5]);
+        done.store(true, AtomicOrdering::Relaxed);
+        assert!(prefault(5, &done).is_empty());
     }
 
     #[test]

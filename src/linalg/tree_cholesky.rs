@@ -153,8 +153,15 @@ pub(crate) struct TreePlan {
     /// Flops of each subtree.
     work: Vec<f64>,
     roots: Vec<usize>,
-    /// Place in the factor's values of each entry of A (its lower CSC, original order).
-    scatter: Vec<usize>,
+    /// The entries of A (its lower CSC, original order) by factor column: those of column
+    /// `c` are `scatter_src[scatter_ptr[c]..scatter_ptr[c + 1]]` (their place in A's values),
+    /// landing at `scatter_dst[..]` in the factor's values.
+    scatter_ptr: Vec<usize>,
+    scatter_src: Vec<usize>,
+    scatter_dst: Vec<usize>,
+    /// Start of each factor column's values (the column's supernode block is column-major),
+    /// and the length at the end.
+    col_start: Vec<usize>,
     /// Widest supernode, for the dense Cholesky's workspace.
     max_width: usize,
     /// Subtrees with more work than this are split among the threads.
@@ -271,21 +278,45 @@ impl TreePlan {
             counts[t] += 1;
         }
 
-        // Where each entry of A lands in the factor.
-        let mut scatter = Vec::with_capacity(row_idx.len());
+        // Where each entry of A lands in the factor, bucketed by factor column so that
+        // assembling A touches the factor in order, column range by column range.
+        let mut col_start = Vec::with_capacity(n + 1);
+        for k in 0..ns {
+            let rows = begin[k + 1] - begin[k] + pat(k).len();
+            col_start.extend((0..begin[k + 1] - begin[k]).map(|c| val_ptr[k] + c * rows));
+        }
+        col_start.push(val_ptr[ns]);
+        let mut scatter_ptr = vec![0usize; n + 1];
         for j in 0..n {
             for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                scatter_ptr[inv[i].min(inv[j]) + 1] += 1;
+            }
+        }
+        for c in 0..n {
+            scatter_ptr[c + 1] += scatter_ptr[c];
+        }
+        let mut next = scatter_ptr.clone();
+        let mut scatter_src = vec![0usize; row_idx.len()];
+        let mut scatter_dst = vec![0usize; row_idx.len()];
+        for j in 0..n {
+            for (p, &i) in row_idx
+                .iter()
+                .enumerate()
+                .take(col_ptr[j + 1])
+                .skip(col_ptr[j])
+            {
                 let (a, b) = (inv[i], inv[j]);
                 let (r, c) = if a >= b { (a, b) } else { (b, a) };
                 let k = super_of[c];
                 let w = begin[k + 1] - begin[k];
-                let rows = w + pat(k).len();
                 let local = if r < begin[k + 1] {
                     r - begin[k]
                 } else {
                     w + pat(k).binary_search(&r).ok()?
                 };
-                scatter.push(val_ptr[k] + (c - begin[k]) * rows + local);
+                scatter_src[next[c]] = p;
+                scatter_dst[next[c]] = col_start[c] + local;
+                next[c] += 1;
             }
         }
         let max_width = (0..ns).map(|k| begin[k + 1] - begin[k]).max().unwrap_or(0);
@@ -302,7 +333,10 @@ impl TreePlan {
             updaters,
             work,
             roots,
-            scatter,
+            scatter_ptr,
+            scatter_src,
+            scatter_dst,
+            col_start,
             max_width,
             split_work: (total / 64.0).max(1e6),
         })
@@ -331,12 +365,15 @@ impl TreePlan {
     /// Factors A (`values` in the layout of its lower CSC pattern) into `l` (faer's
     /// supernodal values). `par`: the kernels' parallelism above the split subtrees. On a
     /// non-positive pivot returns its column in the permuted order (the smallest such
-    /// column among the subtrees that failed).
-    pub(crate) fn factorize(&self, values: &[f64], l: &mut [f64], par: Par) -> Result<(), usize> {
-        l.par_chunks_mut(1 << 16).for_each(|c| c.fill(0.0));
-        for (&p, &v) in self.scatter.iter().zip(values) {
-            l[p] += v;
-        }
+    /// column among the subtrees that failed). `zeroed`: `l` holds only zeros already.
+    pub(crate) fn factorize(
+        &self,
+        values: &[f64],
+        l: &mut [f64],
+        par: Par,
+        zeroed: bool,
+    ) -> Result<(), usize> {
+        self.assemble(values, l, zeroed);
         // The roots' subtrees tile the supernodes in order.
         let mut parts = Vec::with_capacity(self.roots.len());
         let mut rest = l;
@@ -363,6 +400,43 @@ impl TreePlan {
             }
             Ok(())
         }
+    }
+
+    /// Zeros the factor (unless `zeroed`: it holds only zeros) and adds A's entries to their
+    /// places, in ranges of factor columns side by side.
+    fn assemble(&self, values: &[f64], l: &mut [f64], zeroed: bool) {
+        const PIECES: usize = 64;
+        let len = l.len();
+        let mut parts = Vec::with_capacity(PIECES);
+        let mut rest = l;
+        let mut c0 = 0;
+        for piece in 1..=PIECES {
+            // Columns up to about piece/PIECES of the values.
+            let c1 = if piece == PIECES {
+                self.n
+            } else {
+                self.col_start
+                    .partition_point(|&s| s * PIECES < len * piece)
+                    .clamp(c0, self.n)
+            };
+            let (part, tail) = rest.split_at_mut(self.col_start[c1] - self.col_start[c0]);
+            parts.push((c0, c1, part));
+            rest = tail;
+            c0 = c1;
+        }
+        parts.into_par_iter().for_each(|(c0, c1, part)| {
+            if !zeroed {
+                part.fill(0.0);
+            }
+            let base = self.col_start[c0];
+            let entries = self.scatter_ptr[c0]..self.scatter_ptr[c1];
+            for (&p, &d) in self.scatter_src[entries.clone()]
+                .iter()
+                .zip(&self.scatter_dst[entries])
+            {
+                part[d - base] += values[p];
+            }
+        });
     }
 
     /// Factors the subtree of `k`, whose values are `l` (from its first supernode on).
