@@ -331,3 +331,20 @@ pub fn format_fracture(t: &FractureTiming) -> String {
         t.peak_memory as f64 / 1048576.0
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a lattice large enough for breaks in the factor's space (over 20,000 free DOFs), 30
+    /// breaks with the factor kept (the Woodbury update growing to rank 30) break the same
+    /// members at the same load fractions, to 1e-9, as refactoring at every break.
+    #[test]
+    fn breaks_in_the_factor_space_match_refactoring_at_every_break() {
+        let t = measure_fracture([16, 16, 25], 30, 30).unwrap();
+        assert!(t.free_dofs >= 20_000, "{} free DOFs", t.free_dofs);
+        assert!(t.factor_space_seconds.is_some());
+        assert_eq!((t.breaks, t.compared_breaks), (30, 30));
+        assert!(t.same_sequence);
+    }
+}
