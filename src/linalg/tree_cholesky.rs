@@ -168,6 +168,53 @@ pub(crate) struct TreePlan {
     split_work: f64,
 }
 
+/// The supernodes of a supernodal symbolic factor as plain arrays, shared by the tree
+/// factorization and the tree solves.
+pub(crate) struct SupernodeArrays {
+    /// First column of each supernode, and `n` at the end.
+    pub begin: Vec<usize>,
+    /// Supernode `k`'s rows below its columns are `pattern[pattern_ptr[k]..pattern_ptr[k + 1]]`.
+    pub pattern_ptr: Vec<usize>,
+    pub pattern: Vec<usize>,
+    /// Start of each supernode's values in the factor, and their length at the end.
+    pub val_ptr: Vec<usize>,
+    /// The supernode of each column.
+    pub super_of: Vec<usize>,
+}
+
+impl SupernodeArrays {
+    /// The arrays of `s`.
+    pub(crate) fn new(s: &SymbolicSupernodalCholesky<usize>) -> Self {
+        let n = s.nrows();
+        let ns = s.n_supernodes();
+        let begin: Vec<usize> = s
+            .supernode_begin()
+            .iter()
+            .copied()
+            .chain(std::iter::once(n))
+            .collect();
+        let mut pattern_ptr = Vec::with_capacity(ns + 1);
+        let mut pattern = Vec::new();
+        pattern_ptr.push(0);
+        for k in 0..ns {
+            pattern.extend_from_slice(s.supernode(k).pattern());
+            pattern_ptr.push(pattern.len());
+        }
+        let val_ptr = s.col_ptr_for_val().to_vec();
+        let mut super_of = vec![0usize; n];
+        for k in 0..ns {
+            super_of[begin[k]..begin[k + 1]].fill(k);
+        }
+        SupernodeArrays {
+            begin,
+            pattern_ptr,
+            pattern,
+            val_ptr,
+            super_of,
+        }
+    }
+}
+
 /// Per-task workspace.
 struct Scratch {
     /// Row → its place in the current supernode's block.
@@ -189,24 +236,13 @@ impl TreePlan {
     ) -> Option<Self> {
         let n = s.nrows();
         let ns = s.n_supernodes();
-        let begin: Vec<usize> = s
-            .supernode_begin()
-            .iter()
-            .copied()
-            .chain(std::iter::once(n))
-            .collect();
-        let mut pattern_ptr = Vec::with_capacity(ns + 1);
-        let mut pattern = Vec::new();
-        pattern_ptr.push(0);
-        for k in 0..ns {
-            pattern.extend_from_slice(s.supernode(k).pattern());
-            pattern_ptr.push(pattern.len());
-        }
-        let val_ptr = s.col_ptr_for_val().to_vec();
-        let mut super_of = vec![0usize; n];
-        for k in 0..ns {
-            super_of[begin[k]..begin[k + 1]].fill(k);
-        }
+        let SupernodeArrays {
+            begin,
+            pattern_ptr,
+            pattern,
+            val_ptr,
+            super_of,
+        } = SupernodeArrays::new(s);
         let pat = |k: usize| &pattern[pattern_ptr[k]..pattern_ptr[k + 1]];
 
         // Parents, subtree sizes and postorder check.

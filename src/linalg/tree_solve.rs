@@ -14,7 +14,7 @@
 //! and however the subtrees are scheduled (partial sums in a fixed order, no sum across
 //! threads), so results are bitwise the same on one thread and on many.
 
-use super::tree_cholesky::MIN_TREE_DOFS;
+use super::tree_cholesky::{SupernodeArrays, MIN_TREE_DOFS};
 use super::SparseCholesky;
 use crate::Real;
 use rayon::prelude::*;
@@ -156,24 +156,13 @@ impl SupernodalSolver {
             return None;
         }
         let ns = s.n_supernodes();
-        let begin: Vec<usize> = s
-            .supernode_begin()
-            .iter()
-            .copied()
-            .chain(std::iter::once(n))
-            .collect();
-        let mut pattern_ptr = Vec::with_capacity(ns + 1);
-        let mut pattern = Vec::new();
-        pattern_ptr.push(0);
-        for k in 0..ns {
-            pattern.extend_from_slice(s.supernode(k).pattern());
-            pattern_ptr.push(pattern.len());
-        }
-        let val_ptr = s.col_ptr_for_val().to_vec();
-        let mut super_of = vec![0usize; n];
-        for k in 0..ns {
-            super_of[begin[k]..begin[k + 1]].fill(k);
-        }
+        let SupernodeArrays {
+            begin,
+            pattern_ptr,
+            pattern,
+            val_ptr,
+            super_of,
+        } = SupernodeArrays::new(s);
         let parent: Vec<usize> = (0..ns)
             .map(|k| {
                 pattern[pattern_ptr[k]..pattern_ptr[k + 1]]
