@@ -93,23 +93,7 @@ pub(crate) fn postorder(
         }
     }
     // Children in ascending order, then a depth-first postorder from the roots.
-    let mut child_ptr = vec![0usize; n + 1];
-    for &p in &parent {
-        if p != NONE {
-            child_ptr[p + 1] += 1;
-        }
-    }
-    for k in 0..n {
-        child_ptr[k + 1] += child_ptr[k];
-    }
-    let mut fill = child_ptr.clone();
-    let mut child = vec![0usize; child_ptr[n]];
-    for (k, &p) in parent.iter().enumerate() {
-        if p != NONE {
-            child[fill[p]] = k;
-            fill[p] += 1;
-        }
-    }
+    let (child_ptr, child) = children_lists(parent.iter().map(|&p| (p != NONE).then_some(p)));
     let mut order = Vec::with_capacity(n);
     let mut stack: Vec<(usize, usize)> = Vec::new();
     for root in (0..n).filter(|&k| parent[k] == NONE) {
@@ -166,6 +150,30 @@ pub(crate) struct TreePlan {
     max_width: usize,
     /// Subtrees with more work than this are split among the threads.
     split_work: f64,
+}
+
+/// The children of each node of a forest given by its parents (`None` for a root), in
+/// ascending order: node `k`'s are `children[children_ptr[k]..children_ptr[k + 1]]`.
+pub(crate) fn children_lists(
+    parent: impl ExactSizeIterator<Item = Option<usize>> + Clone,
+) -> (Vec<usize>, Vec<usize>) {
+    let n = parent.len();
+    let mut children_ptr = vec![0usize; n + 1];
+    for p in parent.clone().flatten() {
+        children_ptr[p + 1] += 1;
+    }
+    for k in 0..n {
+        children_ptr[k + 1] += children_ptr[k];
+    }
+    let mut fill = children_ptr.clone();
+    let mut children = vec![0usize; children_ptr[n]];
+    for (k, p) in parent.enumerate() {
+        if let Some(p) = p {
+            children[fill[p]] = k;
+            fill[p] += 1;
+        }
+    }
+    (children_ptr, children)
 }
 
 /// The supernodes of a supernodal symbolic factor as plain arrays, shared by the tree
@@ -273,21 +281,7 @@ impl TreePlan {
         if total < MIN_TREE_WORK {
             return None;
         }
-        let mut children_ptr = vec![0usize; ns + 1];
-        for p in parent.iter().flatten() {
-            children_ptr[p + 1] += 1;
-        }
-        for k in 0..ns {
-            children_ptr[k + 1] += children_ptr[k];
-        }
-        let mut fill = children_ptr.clone();
-        let mut children = vec![0usize; children_ptr[ns]];
-        for (k, p) in parent.iter().enumerate() {
-            if let Some(p) = *p {
-                children[fill[p]] = k;
-                fill[p] += 1;
-            }
-        }
+        let (children_ptr, children) = children_lists(parent.iter().copied());
 
         // Descendant d updates every supernode its rows fall in.
         let mut counts = vec![0usize; ns + 1];

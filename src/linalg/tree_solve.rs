@@ -14,7 +14,7 @@
 //! and however the subtrees are scheduled (partial sums in a fixed order, no sum across
 //! threads), so results are bitwise the same on one thread and on many.
 
-use super::tree_cholesky::{SupernodeArrays, MIN_TREE_DOFS};
+use super::tree_cholesky::{children_lists, SupernodeArrays, MIN_TREE_DOFS};
 use super::SparseCholesky;
 use crate::Real;
 use rayon::prelude::*;
@@ -193,21 +193,8 @@ impl SupernodalSolver {
                 entries[p] += entries[k];
             }
         }
-        let mut children_ptr = vec![0usize; ns + 1];
-        for &p in parent.iter().filter(|&&p| p != NONE) {
-            children_ptr[p + 1] += 1;
-        }
-        for k in 0..ns {
-            children_ptr[k + 1] += children_ptr[k];
-        }
-        let mut fill = children_ptr.clone();
-        let mut children = vec![0usize; children_ptr[ns]];
-        for (k, &p) in parent.iter().enumerate() {
-            if p != NONE {
-                children[fill[p]] = k;
-                fill[p] += 1;
-            }
-        }
+        let (children_ptr, children) =
+            children_lists(parent.iter().map(|&p| (p != NONE).then_some(p)));
         let roots: Vec<usize> = (0..ns).filter(|&k| parent[k] == NONE).collect();
         let total: f64 = roots.iter().map(|&r| entries[r]).sum();
         Some(SupernodalSolver {
