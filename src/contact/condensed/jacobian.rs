@@ -5,6 +5,7 @@ use crate::Real;
 use faer::linalg::solvers::Solve;
 use faer::{Accum, Mat, MatMut, Par, Side};
 use nalgebra::{Matrix3, Vector3};
+use std::cell::Cell;
 use std::collections::HashMap;
 
 /// One row of the condensed problem: an active contact's normal (or, with friction, one of
@@ -153,10 +154,29 @@ pub(crate) fn few_slip(rows: &[ContactRow]) -> bool {
     4 * rows.iter().filter(|r| slips(r)).count() <= rows.len()
 }
 
+thread_local! {
+    /// This thread's [`approximate_from`]: [`APPROXIMATE_FROM`] unless a test lowers it to
+    /// drive the large-set mode through the solver on a small pair.
+    static APPROXIMATE_FROM_HERE: Cell<usize> = const { Cell::new(APPROXIMATE_FROM) };
+}
+
+/// Contact rows from which the large-set mode applies on this thread: the approximate factor
+/// when more than a quarter of the rows slip, slipping rows along their slip, the kept factor
+/// across contact sets and Anderson acceleration (see `solver.rs`).
+pub(crate) fn approximate_from() -> usize {
+    APPROXIMATE_FROM_HERE.with(Cell::get)
+}
+
+/// Set this thread's [`approximate_from`] (tests only; the default is [`APPROXIMATE_FROM`]).
+#[cfg(test)]
+pub(crate) fn set_approximate_from(rows: usize) {
+    APPROXIMATE_FROM_HERE.with(|c| c.set(rows));
+}
+
 /// Whether a Jacobian with friction for `rows` should take every slipping contact's tangent
 /// exactly: few rows or few slipping.
 pub(crate) fn exact_for(rows: &[ContactRow]) -> bool {
-    rows.len() < APPROXIMATE_FROM || few_slip(rows)
+    rows.len() < approximate_from() || few_slip(rows)
 }
 
 /// Whether a row's contact slips (a frictionless row: no).
@@ -535,7 +555,7 @@ impl ContactJacobian {
                 .zip(&f.reference_slips)
                 .filter(|&(r, &was)| slips(r) != was)
                 .count();
-            if f.exact && rows.len() >= APPROXIMATE_FROM && !few_slip(rows) {
+            if f.exact && rows.len() >= approximate_from() && !few_slip(rows) {
                 return false;
             }
             if !f.exact && changed * MOST_CHANGED > rows.len() {

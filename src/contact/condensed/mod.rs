@@ -2,10 +2,13 @@
 
 pub(crate) use self::body::{CondenseFailure, CondensedBody, NOT_CANDIDATE};
 pub(crate) use self::jacobian::{
-    exact_for, ContactJacobian, ContactRow, Correction, FrictionRow, APPROXIMATE_FROM,
+    approximate_from, exact_for, ContactJacobian, ContactRow, Correction, FrictionRow,
 };
 pub(crate) use self::solver::CondensedSolver;
 
+mod anderson;
 mod body;
 mod jacobian;
+#[cfg(test)]
+mod large_set_tests;
 mod solver;
