@@ -161,8 +161,8 @@ thread_local! {
 }
 
 /// Contact rows from which the large-set mode applies on this thread: the approximate factor
-/// when more than a quarter of the rows slip, slipping rows along their slip, the kept factor
-/// across contact sets and Anderson acceleration (see `solver.rs`).
+/// when more than a quarter of the rows slip, slipping rows along their slip, and with the
+/// approximate factor Anderson mixing and early letting-go of held contacts (see `solver.rs`).
 pub(crate) fn approximate_from() -> usize {
     APPROXIMATE_FROM_HERE.with(Cell::get)
 }

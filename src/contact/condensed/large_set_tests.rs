@@ -8,9 +8,9 @@ use std::path::Path;
 /// The sheared pair of `tests/friction.rs` with 8 cells per edge instead of 4 (μ = 0.3,
 /// 500 N pressing, the upper box sheared 0.1 mm per step from step 2; 135-158 contacts). With
 /// 4 cells the large-set mode does not converge on the condensed path (step 1 leaves it, the
-/// approximate factor's corrections cycling between residuals of 0.56 and 0.89, as with
-/// main's code before Anderson mixing): the approximate factor is made for fine interfaces,
-/// where a contact's neighbours carry most of what its left-out slip coupling would.
+/// approximate factor's corrections cycling between residuals of about 0.56 and 0.89, the
+/// same with mixing and early letting-go switched off): the approximate factor is made for
+/// fine interfaces (it is used from 2,000 rows), not for coarse ones.
 const SHEARED_PAIR: &str = r#"
 name = "sheared_pair"
 steps = 3
@@ -118,6 +118,7 @@ fn the_large_set_mode_converges_to_the_exact_paths_answer_on_the_sheared_pair() 
         );
     }
     // Contact by contact: the same contacts, each force within 1e-6 of the load.
+    let mut largest: f64 = 0.0;
     for ((ra, sa), (rb, _)) in exact.iter().zip(&large) {
         let load = 500.0 * sa.load_factor;
         for (ba, bb) in ra.bodies.iter().zip(&rb.bodies) {
@@ -131,6 +132,9 @@ fn the_large_set_mode_converges_to_the_exact_paths_answer_on_the_sheared_pair() 
             for (ca, cb) in ba.contacts.iter().zip(&bb.contacts) {
                 assert_eq!(ca.node, cb.node);
                 for (x, y) in ca.force.iter().zip(&cb.force) {
+                    if load > 0.0 {
+                        largest = largest.max((x - y).abs() / load);
+                    }
                     assert!(
                         (x - y).abs() <= 1e-6 * load,
                         "step {}: node {} of {}: {:?} against {:?}",
@@ -144,4 +148,7 @@ fn the_large_set_mode_converges_to_the_exact_paths_answer_on_the_sheared_pair() 
             }
         }
     }
+    println!(
+        "largest difference of a contact force from the exact path's: {largest:.1e} of the load"
+    );
 }
