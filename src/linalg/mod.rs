@@ -19,6 +19,7 @@ mod conjugate_gradient;
 pub mod ldlt;
 mod low_rank;
 pub mod multigrid;
+mod node_symbolic;
 pub mod ordering;
 mod symmetric_csr;
 mod tree_cholesky;
