@@ -465,49 +465,4 @@ mod tests {
             );
         }
     }
-
-    /// Not a test: flops and nnz(L) of the node structure under METIS's default ordering and
-    /// tighter `ufactor`s on the benchmark lattices (analysis only), with METIS's time.
-    /// `cargo test --release --lib metis_imbalance_sizes -- --ignored --nocapture`
-    #[test]
-    #[ignore]
-    fn metis_imbalance_sizes() {
-        use crate::linalg::ordering::{
-            graph_of_pattern, nested_dissection, nested_dissection_with_imbalance,
-        };
-        for cells in [
-            [20, 20, 40],
-            [27, 27, 27],
-            [30, 30, 30],
-            [40, 40, 40],
-            [49, 49, 49],
-        ] {
-            let (s, _) = lattice_system(cells).unwrap();
-            let g = s.groups.as_deref().unwrap();
-            let n_nodes = g.iter().max().unwrap() + 1;
-            let (x, a) = graph_of_pattern(s.n, &s.col_ptr, &s.row_idx, Some(g), n_nodes).unwrap();
-            let mut line = format!("{cells:?} n = {}:", s.n);
-            for u in [0, 30, 50, 100] {
-                let t = std::time::Instant::now();
-                let (p, i) = if u == 0 {
-                    nested_dissection(&x, &a).unwrap()
-                } else {
-                    nested_dissection_with_imbalance(&x, &a, u).unwrap()
-                };
-                let metis = t.elapsed().as_secs_f64();
-                let sym = node_symbolic(s.n, &x, &a, &p, &i, Some(g)).unwrap();
-                line += &format!(
-                    " | ufactor {}: flops {:.4e} nnz(L) {} METIS {metis:.3} s",
-                    if u == 0 {
-                        "default".to_string()
-                    } else {
-                        u.to_string()
-                    },
-                    sym.arrays.flops(),
-                    sym.arrays.nnz()
-                );
-            }
-            println!("{line}");
-        }
-    }
 }

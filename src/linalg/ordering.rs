@@ -44,27 +44,6 @@ pub fn nested_dissection(
     xadj: &[usize],
     adjncy: &[usize],
 ) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
-    nested_dissection_metis(xadj, adjncy, None)
-}
-
-/// [`nested_dissection`] with METIS's `ufactor` option (allowed imbalance of the two parts of
-/// each bisection, in thousandths: 1 + ufactor/1000; METIS's default for orderings is 200).
-/// Used for large bodies only, where a tighter balance gave fewer flops on every lattice tried.
-pub fn nested_dissection_with_imbalance(
-    xadj: &[usize],
-    adjncy: &[usize],
-    ufactor: usize,
-) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
-    let u = idx_t::try_from(ufactor).map_err(|_| too_large("ufactor", ufactor))?;
-    nested_dissection_metis(xadj, adjncy, Some(u))
-}
-
-/// [`nested_dissection`] with METIS's defaults (`ufactor = None`) or that `ufactor`.
-fn nested_dissection_metis(
-    xadj: &[usize],
-    adjncy: &[usize],
-    ufactor: Option<idx_t>,
-) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
     let n = check_csr(xadj, adjncy)?;
     let mut graph = MetisGraph::new(n, xadj, adjncy)?;
     // No edges: every order is fill-free, and METIS gains nothing.
@@ -72,7 +51,7 @@ fn nested_dissection_metis(
         let identity: Vec<usize> = (0..n).collect();
         return Ok((identity.clone(), identity));
     }
-    let (perm, inv) = metis_node_nd(&mut graph, ufactor)?;
+    let (perm, inv) = metis_node_nd(&mut graph)?;
     let perm: Vec<usize> = perm.iter().map(|&p| p as usize).collect();
     let inv: Vec<usize> = inv.iter().map(|&p| p as usize).collect();
     // A wrong permutation from C would corrupt the factorization silently: check it once.
@@ -292,14 +271,11 @@ impl MetisGraph {
     }
 }
 
-/// Calls `METIS_NodeND` with default options (or that `ufactor`) and returns its `(perm, iperm)`.
+/// Calls `METIS_NodeND` with default options and returns its `(perm, iperm)`.
 ///
 /// This is the crate's only `unsafe`. Its soundness rests on [`MetisGraph`]: METIS does
 /// not validate its input, so it only ever sees a graph built by `MetisGraph::new`.
-fn metis_node_nd(
-    graph: &mut MetisGraph,
-    ufactor: Option<idx_t>,
-) -> Result<(Vec<idx_t>, Vec<idx_t>), OrderingError> {
+fn metis_node_nd(graph: &mut MetisGraph) -> Result<(Vec<idx_t>, Vec<idx_t>), OrderingError> {
     let n = graph.xadj.len() - 1;
     let mut nvtxs = idx_t::try_from(n).map_err(|_| too_large("vertices", n))?;
     let mut perm: Vec<idx_t> = vec![0; n];
@@ -311,29 +287,18 @@ fn metis_node_nd(
     // means another call panicked; the generator is re-seeded anyway.
     static METIS: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let _one_at_a_time = METIS.lock().unwrap_or_else(|e| e.into_inner());
-    let mut options = [0 as idx_t; metis_sys::METIS_NOPTIONS as usize];
-    if let Some(u) = ufactor {
-        // SAFETY: `options` holds METIS_NOPTIONS entries, which SetDefaultOptions fills.
-        unsafe { metis_sys::METIS_SetDefaultOptions(options.as_mut_ptr()) };
-        options[metis_sys::moptions_et_METIS_OPTION_UFACTOR as usize] = u;
-    }
-    let options_ptr = match ufactor {
-        Some(_) => options.as_mut_ptr(),
-        None => std::ptr::null_mut(),
-    };
     // SAFETY: `nvtxs` is the vertex count, `xadj` has `nvtxs + 1` offsets ending at
     // `adjncy.len()`, every neighbour is a valid vertex and the graph is symmetric
     // without self loops (all by construction of `MetisGraph`); `perm` and `iperm` hold
-    // `nvtxs` entries each; null `vwgt` selects unit weights, null `options` METIS's
-    // defaults, else `options` holds METIS_NOPTIONS entries set from its defaults (0-based
-    // numbering). METIS keeps no pointer after returning.
+    // `nvtxs` entries each; null `vwgt` and `options` select unit weights and METIS's
+    // defaults (0-based numbering). METIS keeps no pointer after returning.
     let status = unsafe {
         metis_sys::METIS_NodeND(
             &mut nvtxs,
             graph.xadj.as_mut_ptr(),
             graph.adjncy.as_mut_ptr(),
             std::ptr::null_mut(),
-            options_ptr,
+            std::ptr::null_mut(),
             perm.as_mut_ptr(),
             iperm.as_mut_ptr(),
         )
@@ -531,7 +496,7 @@ mod tests {
     fn metis_node_nd_orders_a_grid() {
         let (xadj, adj) = grid(7, 5);
         let mut graph = MetisGraph::new(35, &xadj, &adj).unwrap();
-        let (perm, iperm) = metis_node_nd(&mut graph, None).unwrap();
+        let (perm, iperm) = metis_node_nd(&mut graph).unwrap();
         let perm: Vec<usize> = perm.iter().map(|&p| p as usize).collect();
         let iperm: Vec<usize> = iperm.iter().map(|&p| p as usize).collect();
         assert_perm_pair(&perm, &iperm, 35);
