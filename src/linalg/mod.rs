@@ -21,5 +21,6 @@ mod low_rank;
 pub mod multigrid;
 pub mod ordering;
 mod symmetric_csr;
+mod trailing_order;
 mod tree_cholesky;
 pub mod tree_solve;
