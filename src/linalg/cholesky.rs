@@ -21,6 +21,7 @@ use super::ordering::{
     expand_to_dofs, factor_entries, graph_of_pattern, nested_dissection,
     nested_dissection_with_trailing, OrderingError,
 };
+use super::trailing_order::postorder_keeping_trailing;
 use super::tree_cholesky::{SupernodeArrays, TreePlan, MIN_TREE_DOFS};
 use super::tree_solve::{ReachWork, SupernodalSolver};
 
@@ -313,6 +314,8 @@ impl SparseCholesky {
     /// `groups[dof] = node`) ordered last and the others by METIS nested dissection, in the
     /// supernodal layout: the last block of the factor is then the Cholesky factor of the
     /// Schur complement on the trailing DOFs ([`trailing_factor`](Self::trailing_factor)).
+    /// Large bodies analysed for several threads are postordered for the tree-parallel
+    /// factorization and solves when that keeps the trailing DOFs last (one tree holds them).
     pub fn analyze_trailing(
         n: usize,
         col_ptr: &[usize],
@@ -331,7 +334,16 @@ impl SparseCholesky {
         let n_nodes = trailing.len();
         let (xadj, adjncy) = graph_of_pattern(n, col_ptr, row_idx, Some(groups), n_nodes)?;
         let (node_perm, _) = nested_dissection_with_trailing(&xadj, &adjncy, trailing)?;
-        let custom = Some(expand_to_dofs(&node_perm, groups)?);
+        let (perm, inv) = expand_to_dofs(&node_perm, groups)?;
+        // Large bodies on several threads: postordered for the tree-parallel factorization and
+        // solves, as in `analyze_with`, where the trailing DOFs stay last.
+        let postordered = (threads != 1 && n >= MIN_TREE_DOFS)
+            .then(|| {
+                postorder_keeping_trailing(col_ptr, row_idx, &perm, &inv, |d| trailing[groups[d]])
+            })
+            .flatten();
+        let tree_parallel = postordered.is_some();
+        let custom = Some(postordered.unwrap_or((perm, inv)));
         let options = CholeskyOptions {
             ordering: FillOrdering::NestedDissection,
             layout: FactorLayout::Supernodal,
@@ -345,7 +357,7 @@ impl SparseCholesky {
             pattern,
             symbolic,
             options,
-            false,
+            tree_parallel,
             Vec::new(),
         )
     }

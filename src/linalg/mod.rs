@@ -22,5 +22,6 @@ pub mod multigrid;
 mod node_symbolic;
 pub mod ordering;
 mod symmetric_csr;
+mod trailing_order;
 mod tree_cholesky;
 pub mod tree_solve;
