@@ -113,7 +113,8 @@ impl DirectTiming {
 }
 
 /// Orders, factors and solves `s` with [`SparseCholesky`] and `options`, timing each phase;
-/// `tree = false` factors with faer's own supernode loop instead of the tree-parallel one.
+/// `tree = false` analyses, factors and solves with faer as for a small body instead of the
+/// tree path (the node graph's analysis, the tree-parallel factorization, the tree solves).
 pub fn time_direct(
     s: &LowerSystem,
     options: CholeskyOptions,
@@ -121,12 +122,13 @@ pub fn time_direct(
 ) -> Result<DirectTiming, String> {
     let cpu0 = cpu_seconds();
     let t = Instant::now();
-    let mut c =
-        SparseCholesky::analyze_with(s.n, &s.col_ptr, &s.row_idx, s.groups.as_deref(), options)
-            .map_err(|e| e.to_string())?;
-    if !tree {
-        c.disable_tree_parallel();
-    }
+    let analyze_with = if tree {
+        SparseCholesky::analyze_with
+    } else {
+        SparseCholesky::analyze_with_faers_loop
+    };
+    let mut c = analyze_with(s.n, &s.col_ptr, &s.row_idx, s.groups.as_deref(), options)
+        .map_err(|e| e.to_string())?;
     let analyze = t.elapsed().as_secs_f64();
     let t = Instant::now();
     c.factorize(&s.values).map_err(|e| e.to_string())?;

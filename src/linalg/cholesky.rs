@@ -16,11 +16,14 @@ use faer::{Conj, MatMut, Par, Side};
 use rayon::iter::ParallelExtend;
 use std::sync::atomic::{AtomicBool, Ordering as AtomicOrdering};
 
+use super::node_symbolic::{node_symbolic, NodeSymbolic};
 use super::ordering::{
     expand_to_dofs, factor_entries, graph_of_pattern, nested_dissection,
     nested_dissection_with_trailing, OrderingError,
 };
-use super::tree_cholesky::{postorder, TreePlan, MIN_TREE_DOFS};
+use super::trailing_order::postorder_keeping_trailing;
+use super::tree_cholesky::{SupernodeArrays, TreePlan, MIN_TREE_DOFS};
+use super::tree_solve::{ReachWork, SupernodalSolver};
 
 /// Default smallest accepted pivot ratio `d_j / A_jj` (dimensionless): below it the
 /// matrix is treated as singular to working precision.
@@ -143,7 +146,7 @@ pub struct SparseCholesky {
     n: usize,
     /// A's lower-triangle pattern, kept to view each new value array as a matrix.
     pattern: SymbolicSparseColMat<usize>,
-    symbolic: SymbolicCholesky<usize>,
+    structure: Structure,
     /// `perm[new] = old`.
     perm: Vec<usize>,
     /// Position in A's value array of the diagonal entry of permuted column j.
@@ -161,6 +164,22 @@ pub struct SparseCholesky {
     factorized: bool,
     /// `l_values` holds only zeros (nothing factored into it since the analysis).
     l_zero: bool,
+}
+
+/// The factor's symbolic structure and what solves with it.
+enum Structure {
+    /// faer's analysis of the DOF matrix; faer's factorization (or the tree plan's, in
+    /// faer's storage) and faer's solve.
+    Faer(SymbolicCholesky<usize>),
+    /// The tree path's own supernodes from the node graph ([`node_symbolic`]): factored by
+    /// the tree plan, solved by the supernodal solver with these buffers.
+    Nodes {
+        arrays: SupernodeArrays,
+        solver: Box<SupernodalSolver>,
+        work: ReachWork,
+        /// The right-hand side in the permuted order.
+        x: Vec<f64>,
+    },
 }
 
 impl fmt::Debug for SparseCholesky {
@@ -197,6 +216,29 @@ impl SparseCholesky {
         groups: Option<&[usize]>,
         options: CholeskyOptions,
     ) -> Result<Self, CholeskyError> {
+        Self::analyze_inner(n, col_ptr, row_idx, groups, options, true)
+    }
+
+    /// [`analyze_with`](Self::analyze_with) as it is for small bodies, whatever the size:
+    /// faer's analysis, factorization and solve, without the tree path (for comparisons).
+    pub fn analyze_with_faers_loop(
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        groups: Option<&[usize]>,
+        options: CholeskyOptions,
+    ) -> Result<Self, CholeskyError> {
+        Self::analyze_inner(n, col_ptr, row_idx, groups, options, false)
+    }
+
+    fn analyze_inner(
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        groups: Option<&[usize]>,
+        options: CholeskyOptions,
+        tree_allowed: bool,
+    ) -> Result<Self, CholeskyError> {
         check_lower_pattern(n, col_ptr, row_idx)?;
         if let Some(g) = groups {
             if g.len() != n {
@@ -208,7 +250,8 @@ impl SparseCholesky {
         }
 
         // Large bodies on several threads: postorder, so that the tree plan applies.
-        let tree_parallel = options.ordering == FillOrdering::NestedDissection
+        let tree_parallel = tree_allowed
+            && options.ordering == FillOrdering::NestedDissection
             && options.threads != 1
             && n >= MIN_TREE_DOFS;
         let custom = match options.ordering {
@@ -216,10 +259,6 @@ impl SparseCholesky {
                 let n_nodes = groups.map_or(n, |g| g.iter().max().map_or(0, |&m| m + 1));
                 let (xadj, adjncy) = graph_of_pattern(n, col_ptr, row_idx, groups, n_nodes)?;
                 let (node_perm, node_inv) = nested_dissection(&xadj, &adjncy)?;
-                let (perm, inv) = match groups {
-                    Some(g) => expand_to_dofs(&node_perm, g)?,
-                    None => (node_perm.clone(), node_inv.clone()),
-                };
                 if tree_parallel {
                     // The factor's pages are faulted in on the other core while the ordering
                     // is postordered and analysed (the first touch of a 2 GB factor takes
@@ -238,19 +277,18 @@ impl SparseCholesky {
                             prefault(entries, &done)
                         },
                         || {
-                            let custom = postorder(col_ptr, row_idx, &perm, &inv);
                             let analysed =
-                                symbolic_analysis(n, col_ptr, row_idx, Some(custom), options);
+                                node_symbolic(n, &xadj, &adjncy, &node_perm, &node_inv, groups);
                             done.store(true, AtomicOrdering::Relaxed);
                             analysed
                         },
                     );
-                    let (pattern, symbolic) = analysed?;
-                    return Self::from_symbolic(
-                        n, col_ptr, row_idx, pattern, symbolic, options, true, early,
-                    );
+                    return Self::from_nodes(n, col_ptr, row_idx, analysed?, options, early);
                 }
-                Some((perm, inv))
+                Some(match groups {
+                    Some(g) => expand_to_dofs(&node_perm, g)?,
+                    None => (node_perm, node_inv),
+                })
             }
             // faer 0.24's `SymmetricOrdering::Identity` skips the conversion to the upper
             // triangle its symbolic analysis reads, so a lower-triangle input gets a wrong
@@ -276,6 +314,8 @@ impl SparseCholesky {
     /// `groups[dof] = node`) ordered last and the others by METIS nested dissection, in the
     /// supernodal layout: the last block of the factor is then the Cholesky factor of the
     /// Schur complement on the trailing DOFs ([`trailing_factor`](Self::trailing_factor)).
+    /// Large bodies analysed for several threads are postordered for the tree-parallel
+    /// factorization and solves when that keeps the trailing DOFs last (one tree holds them).
     pub fn analyze_trailing(
         n: usize,
         col_ptr: &[usize],
@@ -294,7 +334,16 @@ impl SparseCholesky {
         let n_nodes = trailing.len();
         let (xadj, adjncy) = graph_of_pattern(n, col_ptr, row_idx, Some(groups), n_nodes)?;
         let (node_perm, _) = nested_dissection_with_trailing(&xadj, &adjncy, trailing)?;
-        let custom = Some(expand_to_dofs(&node_perm, groups)?);
+        let (perm, inv) = expand_to_dofs(&node_perm, groups)?;
+        // Large bodies on several threads: postordered for the tree-parallel factorization and
+        // solves, as in `analyze_with`, where the trailing DOFs stay last.
+        let postordered = (threads != 1 && n >= MIN_TREE_DOFS)
+            .then(|| {
+                postorder_keeping_trailing(col_ptr, row_idx, &perm, &inv, |d| trailing[groups[d]])
+            })
+            .flatten();
+        let tree_parallel = postordered.is_some();
+        let custom = Some(postordered.unwrap_or((perm, inv)));
         let options = CholeskyOptions {
             ordering: FillOrdering::NestedDissection,
             layout: FactorLayout::Supernodal,
@@ -308,9 +357,85 @@ impl SparseCholesky {
             pattern,
             symbolic,
             options,
-            false,
+            tree_parallel,
             Vec::new(),
         )
+    }
+
+    /// The solver for the node graph's analysis: the factor's buffer (continuing `early`),
+    /// the tree plan and the supernodal solver. Where the tree plan does not apply (one
+    /// thread, too little work), faer analyses the same ordering and the solver is faer's
+    /// loop on it, postordered as before.
+    fn from_nodes(
+        n: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        analysed: NodeSymbolic,
+        options: CholeskyOptions,
+        early: Vec<f64>,
+    ) -> Result<Self, CholeskyError> {
+        let NodeSymbolic { arrays, perm, inv } = analysed;
+        let par = match options.threads {
+            1 => Par::Seq,
+            t => Par::rayon(t),
+        };
+        let multi = matches!(par, Par::Rayon(t) if t.get() > 1);
+        let len = arrays.val_ptr.last().copied().unwrap_or(0);
+        let ((l_values, solver), tree) = rayon::join(
+            || {
+                (
+                    zeroed(early, len),
+                    SupernodalSolver::from_arrays(arrays.clone(), perm.clone()),
+                )
+            },
+            || {
+                if multi {
+                    TreePlan::new(arrays.clone(), col_ptr, row_idx, &inv)
+                } else {
+                    None
+                }
+            },
+        );
+        let (Some(tree), Some(solver)) = (tree, solver) else {
+            let (pattern, symbolic) =
+                symbolic_analysis(n, col_ptr, row_idx, Some((perm, inv)), options)?;
+            return Self::from_symbolic(
+                n,
+                col_ptr,
+                row_idx,
+                pattern,
+                symbolic,
+                options,
+                true,
+                Vec::new(),
+            );
+        };
+        let l_values = l_values?;
+        let pattern =
+            SymbolicSparseColMat::new_checked(n, n, col_ptr.to_vec(), None, row_idx.to_vec());
+        let a_diag: Vec<usize> = perm.iter().map(|&old| col_ptr[old]).collect();
+        let l_diag = arrays.diagonal_positions();
+        Ok(Self {
+            n,
+            pattern,
+            structure: Structure::Nodes {
+                arrays,
+                solver: Box::new(solver),
+                work: ReachWork::default(),
+                x: vec![0.0; n],
+            },
+            perm,
+            a_diag,
+            l_diag,
+            l_values,
+            mem: MemBuffer::new(StackReq::EMPTY),
+            par,
+            tree: Some(tree),
+            pivot_tolerance: DEFAULT_PIVOT_TOLERANCE,
+            ordering: options.ordering,
+            factorized: false,
+            l_zero: true,
+        })
     }
 
     /// The solver for a finished symbolic analysis: the factor's buffer (continuing `early`,
@@ -357,7 +482,7 @@ impl SparseCholesky {
                     for (new, &old) in perm.iter().enumerate() {
                         inv[old] = new;
                     }
-                    TreePlan::new(s, col_ptr, row_idx, &inv)
+                    TreePlan::new(SupernodeArrays::new(s), col_ptr, row_idx, &inv)
                 }
                 _ => None,
             },
@@ -366,7 +491,7 @@ impl SparseCholesky {
         Ok(Self {
             n,
             pattern,
-            symbolic,
+            structure: Structure::Faer(symbolic),
             perm,
             a_diag,
             l_diag,
@@ -414,8 +539,14 @@ impl SparseCholesky {
             }
             return self.check_pivots(values);
         }
+        let Structure::Faer(symbolic) = &self.structure else {
+            // The node graph's structure is only built with its tree plan.
+            return Err(CholeskyError::Resources(
+                "no factorization for the node graph's structure".into(),
+            ));
+        };
         let a = SparseColMatRef::new(self.pattern.as_ref(), values);
-        let result = self.symbolic.factorize_numeric_llt(
+        let result = symbolic.factorize_numeric_llt(
             &mut self.l_values,
             a,
             Side::Lower,
@@ -436,13 +567,6 @@ impl SparseCholesky {
     /// more than one thread).
     pub fn is_tree_parallel(&self) -> bool {
         self.tree.is_some()
-    }
-
-    /// Use faer's own sequential supernode loop from now on (for comparisons).
-    pub fn disable_tree_parallel(&mut self) {
-        self.tree = None;
-        self.l_zero = false;
-        self.factorized = false;
     }
 
     /// Rejects a factor with a pivot ratio below the tolerance; marks it usable otherwise.
@@ -479,17 +603,46 @@ impl SparseCholesky {
         );
         assert_eq!(rhs.len(), self.n, "right-hand side length must equal n");
         let n = self.n;
-        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
-            self.par,
-            MemStack::new(&mut self.mem),
-        );
+        match &mut self.structure {
+            Structure::Faer(symbolic) => LltRef::new(symbolic, &self.l_values)
+                .solve_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(rhs, n, 1),
+                    self.par,
+                    MemStack::new(&mut self.mem),
+                ),
+            Structure::Nodes {
+                solver, work, x, ..
+            } => {
+                for (xi, &old) in x.iter_mut().zip(&self.perm) {
+                    *xi = rhs[old];
+                }
+                solver.forward(&self.l_values, x, work);
+                solver.backward(&self.l_values, x);
+                for (&xi, &old) in x.iter().zip(&self.perm) {
+                    rhs[old] = xi;
+                }
+            }
+        }
     }
 
     /// n, nnz(A lower), nnz(L), and whether the factorization is supernodal, for printing.
     pub fn stats(&self) -> CholeskyStats {
-        let (supernodal, supernodes, nnz_l) = match self.symbolic.raw() {
+        let raw = match &self.structure {
+            Structure::Faer(symbolic) => symbolic.raw(),
+            Structure::Nodes { arrays, .. } => {
+                return CholeskyStats {
+                    n: self.n,
+                    nnz_a: self.pattern.row_idx().len(),
+                    nnz_l: arrays.nnz(),
+                    factor_values: self.l_values.len(),
+                    supernodal: true,
+                    supernodes: arrays.len(),
+                    ordering: self.ordering,
+                }
+            }
+        };
+        let (supernodal, supernodes, nnz_l) = match raw {
             SymbolicCholeskyRaw::Simplicial(s) => (false, 0, s.len_val()),
             SymbolicCholeskyRaw::Supernodal(s) => {
                 let begin = s.supernode_begin();
@@ -522,11 +675,40 @@ impl SparseCholesky {
 
     /// The supernodal structure of the factor (`None` when simplicial), for solves that walk
     /// it ([`SupernodalSolver`](super::tree_solve::SupernodalSolver)).
+    /// `None` also for the tree path's own structure: see
+    /// [`supernode_arrays`](Self::supernode_arrays).
     pub(crate) fn supernodal_symbolic(&self) -> Option<&SymbolicSupernodalCholesky<usize>> {
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Supernodal(s) => Some(s),
-            SymbolicCholeskyRaw::Simplicial(_) => None,
+        match &self.structure {
+            Structure::Faer(symbolic) => match symbolic.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => Some(s),
+                SymbolicCholeskyRaw::Simplicial(_) => None,
+            },
+            Structure::Nodes { .. } => None,
         }
+    }
+
+    /// The factor's supernodes as plain arrays (`None` when simplicial), whichever analysis
+    /// built them.
+    pub(crate) fn supernode_arrays(&self) -> Option<SupernodeArrays> {
+        match &self.structure {
+            Structure::Faer(symbolic) => match symbolic.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => Some(SupernodeArrays::new(s)),
+                SymbolicCholeskyRaw::Simplicial(_) => None,
+            },
+            Structure::Nodes { arrays, .. } => Some(arrays.clone()),
+        }
+    }
+
+    /// Flops of the numeric factorization by its supernodes (w³/3 + w²p + wp² for w columns
+    /// and p rows below them); `None` when simplicial.
+    pub fn factor_flops(&self) -> Option<f64> {
+        self.supernode_arrays().map(|a| a.flops())
+    }
+
+    /// Whether the factor's structure comes from the node graph (the tree path's own
+    /// analysis) rather than from faer's analysis of the DOF matrix.
+    pub fn has_node_structure(&self) -> bool {
+        matches!(self.structure, Structure::Nodes { .. })
     }
 
     /// The factor's values in faer's storage, `None` unless the last factorization succeeded.
@@ -566,7 +748,11 @@ impl SparseCholesky {
         if !self.factorized || m > self.n {
             return None;
         }
-        let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
+        // analyze_trailing always analyses with faer.
+        let Structure::Faer(symbolic) = &self.structure else {
+            return None;
+        };
+        let SymbolicCholeskyRaw::Supernodal(s) = symbolic.raw() else {
             return None;
         };
         let first = self.n - m;
@@ -598,9 +784,12 @@ impl SparseCholesky {
     fn failed_column(&self, index: usize) -> usize {
         // faer 0.24 reports the column one-based from its simplicial kernel and
         // zero-based from its supernodal (dense) kernel; the tests pin both.
-        let col = match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(_) => index.saturating_sub(1),
-            SymbolicCholeskyRaw::Supernodal(_) => index,
+        let col = match &self.structure {
+            Structure::Faer(symbolic) => match symbolic.raw() {
+                SymbolicCholeskyRaw::Simplicial(_) => index.saturating_sub(1),
+                SymbolicCholeskyRaw::Supernodal(_) => index,
+            },
+            Structure::Nodes { .. } => index,
         };
         col.min(self.n.saturating_sub(1))
     }
@@ -608,7 +797,7 @@ impl SparseCholesky {
 
 /// Pattern (a copy of A's lower CSC) and faer's symbolic analysis with `custom =
 /// Some((perm, inv))` or AMD, in the layout `options` asks for.
-fn symbolic_analysis(
+pub(crate) fn symbolic_analysis(
     n: usize,
     col_ptr: &[usize],
     row_idx: &[usize],

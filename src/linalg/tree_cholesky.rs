@@ -177,7 +177,9 @@ pub(crate) fn children_lists(
 }
 
 /// The supernodes of a supernodal symbolic factor as plain arrays, shared by the tree
-/// factorization and the tree solves.
+/// factorization and the tree solves: read from faer's analysis ([`SupernodeArrays::new`]) or
+/// built from the node graph ([`node_symbolic`](super::node_symbolic)).
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) struct SupernodeArrays {
     /// First column of each supernode, and `n` at the end.
     pub begin: Vec<usize>,
@@ -221,6 +223,54 @@ impl SupernodeArrays {
             super_of,
         }
     }
+
+    /// Columns (rows) of the factor.
+    pub(crate) fn n(&self) -> usize {
+        self.begin.last().copied().unwrap_or(0)
+    }
+
+    /// Number of supernodes.
+    pub(crate) fn len(&self) -> usize {
+        self.begin.len().saturating_sub(1)
+    }
+
+    /// Rows of supernode `k` below its diagonal block.
+    pub(crate) fn pattern(&self, k: usize) -> &[usize] {
+        &self.pattern[self.pattern_ptr[k]..self.pattern_ptr[k + 1]]
+    }
+
+    /// Entries of L's lower triangle, diagonal included (a supernode's zeros counted).
+    pub(crate) fn nnz(&self) -> usize {
+        (0..self.len())
+            .map(|k| {
+                let w = self.begin[k + 1] - self.begin[k];
+                w * (w + 1) / 2 + w * self.pattern(k).len()
+            })
+            .sum()
+    }
+
+    /// Flops of the factorization: w³/3 + w²p + wp² per supernode (w columns, p rows below).
+    pub(crate) fn flops(&self) -> f64 {
+        (0..self.len())
+            .map(|k| {
+                let w = (self.begin[k + 1] - self.begin[k]) as f64;
+                let p = self.pattern(k).len() as f64;
+                w * w * w / 3.0 + w * w * p + w * p * p
+            })
+            .sum()
+    }
+
+    /// Position of each diagonal entry L_jj in the factor's values (supernode blocks are
+    /// column-major, their square diagonal block on top).
+    pub(crate) fn diagonal_positions(&self) -> Vec<usize> {
+        let mut pos = Vec::with_capacity(self.n());
+        for k in 0..self.len() {
+            let w = self.begin[k + 1] - self.begin[k];
+            let rows = w + self.pattern(k).len();
+            pos.extend((0..w).map(|c| self.val_ptr[k] + c * rows + c));
+        }
+        pos
+    }
 }
 
 /// Per-task workspace.
@@ -233,24 +283,25 @@ struct Scratch {
 }
 
 impl TreePlan {
-    /// The plan for `s` with A's lower pattern (`col_ptr`, `row_idx`, original order) and
-    /// the permutation `inv[old] = new` of the symbolic analysis. `None` when the supernodes
-    /// are not in postorder or the work is too small to gain from it.
+    /// The plan for the supernodes `arrays` with A's lower pattern (`col_ptr`, `row_idx`,
+    /// original order) and the permutation `inv[old] = new` of the symbolic analysis. `None`
+    /// when the supernodes are not in postorder, an entry of A falls outside the structure or
+    /// the work is too small to gain from it.
     pub(crate) fn new(
-        s: &SymbolicSupernodalCholesky<usize>,
+        arrays: SupernodeArrays,
         col_ptr: &[usize],
         row_idx: &[usize],
         inv: &[usize],
     ) -> Option<Self> {
-        let n = s.nrows();
-        let ns = s.n_supernodes();
+        let n = arrays.n();
+        let ns = arrays.len();
         let SupernodeArrays {
             begin,
             pattern_ptr,
             pattern,
             val_ptr,
             super_of,
-        } = SupernodeArrays::new(s);
+        } = arrays;
         let pat = |k: usize| &pattern[pattern_ptr[k]..pattern_ptr[k + 1]];
 
         // Parents, subtree sizes and postorder check.
@@ -718,23 +769,26 @@ mod tests {
     use crate::bench::cholmod::{lattice_system, relative_residual};
     use crate::linalg::cholesky::{CholeskyError, CholeskyOptions, SparseCholesky};
 
-    fn analyzed(s: &crate::bench::cholmod::LowerSystem) -> SparseCholesky {
+    fn analyzed(s: &crate::bench::cholmod::LowerSystem, tree: bool) -> SparseCholesky {
         let options = CholeskyOptions {
             threads: 2,
             ..Default::default()
         };
-        SparseCholesky::analyze_with(s.n, &s.col_ptr, &s.row_idx, s.groups.as_deref(), options)
-            .unwrap()
+        let analyze = if tree {
+            SparseCholesky::analyze_with
+        } else {
+            SparseCholesky::analyze_with_faers_loop
+        };
+        analyze(s.n, &s.col_ptr, &s.row_idx, s.groups.as_deref(), options).unwrap()
     }
 
     #[test]
     fn tree_factor_solves_like_faers_loop() {
         // 16×16×25 cells, 21,675 DOFs: large enough for the tree plan (MIN_TREE_DOFS, MIN_TREE_WORK).
         let (s, _) = lattice_system([16, 16, 25]).unwrap();
-        let mut tree = analyzed(&s);
+        let mut tree = analyzed(&s, true);
         assert!(tree.is_tree_parallel());
-        let mut plain = analyzed(&s);
-        plain.disable_tree_parallel();
+        let mut plain = analyzed(&s, false);
         assert!(!plain.is_tree_parallel());
         let (mut x, mut y) = (s.rhs.clone(), s.rhs.clone());
         tree.factorize(&s.values).unwrap();
@@ -775,10 +829,7 @@ mod tests {
         let dof = 1234;
         s.values[s.col_ptr[dof]] = -1.0;
         for tree in [true, false] {
-            let mut c = analyzed(&s);
-            if !tree {
-                c.disable_tree_parallel();
-            }
+            let mut c = analyzed(&s, tree);
             assert_eq!(c.is_tree_parallel(), tree);
             assert_eq!(
                 c.factorize(&s.values),

@@ -150,19 +150,25 @@ impl SupernodalSolver {
     /// (`MIN_TREE_DOFS`, as for the tree-parallel factorization: smaller bodies keep faer's
     /// solves and their exact results).
     pub fn new(chol: &SparseCholesky) -> Option<Self> {
-        let s = chol.supernodal_symbolic()?;
-        let n = s.nrows();
-        if n < MIN_TREE_DOFS {
+        let arrays = chol.supernode_arrays()?;
+        if arrays.n() < MIN_TREE_DOFS {
             return None;
         }
-        let ns = s.n_supernodes();
+        Self::from_arrays(arrays, chol.permutation().to_vec())
+    }
+
+    /// The solver for the supernodes `arrays` of a factor of `P A Pᵀ`, `perm[new] = old`;
+    /// `None` when a supernode's parent comes before it.
+    pub(crate) fn from_arrays(arrays: SupernodeArrays, perm: Vec<usize>) -> Option<Self> {
+        let n = arrays.n();
+        let ns = arrays.len();
         let SupernodeArrays {
             begin,
             pattern_ptr,
             pattern,
             val_ptr,
             super_of,
-        } = SupernodeArrays::new(s);
+        } = arrays;
         let parent: Vec<usize> = (0..ns)
             .map(|k| {
                 pattern[pattern_ptr[k]..pattern_ptr[k + 1]]
@@ -170,7 +176,6 @@ impl SupernodalSolver {
                     .map_or(NONE, |&r| super_of[r])
             })
             .collect();
-        let perm = chol.permutation().to_vec();
         let mut inv = vec![0usize; n];
         for (new, &old) in perm.iter().enumerate() {
             inv[old] = new;
@@ -328,6 +333,149 @@ impl SupernodalSolver {
             let (sb, se) = (self.begin[k], self.begin[k + 1]);
             if let Some(c0) = x[sb..se].iter().position(|&v| v != 0.0) {
                 self.forward_supernode(k, c0, l, x, &mut work.below);
+            }
+        }
+    }
+
+    /// `x ← L⁻¹ x`, `x` dense in the permuted order, independent subtrees side by side (falls
+    /// back to [`forward_dense`](Self::forward_dense) when the ordering is not a postorder).
+    ///
+    /// A subtree's updates of the rows after it (its root's pattern, as for every supernode
+    /// in it) are summed in a buffer of its own and subtracted once its siblings are done, in
+    /// the order of the children. Which subtrees are split depends on the structure only, so
+    /// the result has the same bits on any number of threads (not those of `forward_dense`).
+    pub fn forward(&self, l: &[f64], x: &mut [Real], work: &mut ReachWork) {
+        assert_eq!(
+            x.len(),
+            self.n,
+            "forward solve of a vector of the wrong length"
+        );
+        let Some(first) = &self.first else {
+            return self.forward_dense(l, x, work);
+        };
+        let mut parts = Vec::with_capacity(self.roots.len());
+        let mut rest = x;
+        for &r in &self.roots {
+            let lo = self.begin[first[r]];
+            let (part, tail) = rest.split_at_mut(self.begin[r + 1] - lo);
+            parts.push((r, lo, part));
+            rest = tail;
+        }
+        // A root's pattern is empty: nothing leaves its subtree.
+        parts.into_par_iter().for_each(|(r, lo, part)| {
+            self.forward_subtree(r, l, part, lo, &mut [], &mut Vec::new(), 0)
+        });
+    }
+
+    /// Forward-solves the subtree of `k`, whose columns `local` holds (from column `lo` on);
+    /// the updates of rows after the subtree are added to `out` (one entry per row of `k`'s
+    /// pattern).
+    #[allow(clippy::too_many_arguments)]
+    fn forward_subtree(
+        &self,
+        k: usize,
+        l: &[f64],
+        local: &mut [Real],
+        lo: usize,
+        out: &mut [Real],
+        below: &mut Vec<Real>,
+        depth: usize,
+    ) {
+        let Some(first) = &self.first else {
+            return;
+        };
+        let outside = self.pattern(k);
+        let mut chain_start = first[k];
+        if depth < MAX_SPLIT_DEPTH && self.entries[k] > self.split_entries {
+            let mut fork = k;
+            while let [only] = self.children(fork) {
+                fork = *only;
+            }
+            let children = self.children(fork);
+            if !children.is_empty() {
+                let (lower, _) = local.split_at_mut(self.begin[fork] - lo);
+                let mut parts = Vec::with_capacity(children.len());
+                let mut rest = lower;
+                for &c in children {
+                    let start = self.begin[first[c]];
+                    let (part, tail) = rest.split_at_mut(self.begin[c + 1] - start);
+                    parts.push((c, start, part, vec![0.0; self.pattern(c).len()]));
+                    rest = tail;
+                }
+                parts.par_iter_mut().for_each(|(c, start, part, buf)| {
+                    self.forward_subtree(*c, l, part, *start, buf, &mut Vec::new(), depth + 1)
+                });
+                let sums: Vec<(usize, Vec<Real>)> =
+                    parts.into_iter().map(|(c, _, _, buf)| (c, buf)).collect();
+                for (c, buf) in &sums {
+                    self.scatter_out(self.pattern(*c), buf, local, lo, outside, out);
+                }
+                chain_start = fork;
+            }
+        }
+        for s in chain_start..=k {
+            self.forward_block(s, l, local, lo, below);
+            let pat = self.pattern(s);
+            self.scatter_out(pat, below, local, lo, outside, out);
+        }
+    }
+
+    /// Subtracts `values` (at the ascending rows `rows`) from `local` (rows from `lo` on)
+    /// where the rows fall in it, and adds them to `out` (at the places of `outside`, the
+    /// ascending rows after `local`, which hold every other row) elsewhere.
+    fn scatter_out(
+        &self,
+        rows: &[usize],
+        values: &[Real],
+        local: &mut [Real],
+        lo: usize,
+        outside: &[usize],
+        out: &mut [Real],
+    ) {
+        let hi = lo + local.len();
+        let split = rows.partition_point(|&r| r < hi);
+        for (&r, &v) in rows[..split].iter().zip(values) {
+            local[r - lo] -= v;
+        }
+        let mut j = 0;
+        for (&r, &v) in rows[split..].iter().zip(&values[split..]) {
+            while outside[j] != r {
+                j += 1;
+            }
+            out[j] += v;
+        }
+    }
+
+    /// The forward solve of supernode `k`'s own columns in `local` (rows from `lo` on), and
+    /// in `below` the products of its rows below them with those columns.
+    fn forward_block(
+        &self,
+        k: usize,
+        l: &[f64],
+        local: &mut [Real],
+        lo: usize,
+        below: &mut Vec<Real>,
+    ) {
+        let (sb, se) = (self.begin[k], self.begin[k + 1]);
+        let w = se - sb;
+        let pat = self.pattern(k);
+        let rows = w + pat.len();
+        let block = &l[self.val_ptr[k]..self.val_ptr[k + 1]];
+        below.clear();
+        below.resize(pat.len(), 0.0);
+        let top = &mut local[sb - lo..se - lo];
+        for c in 0..w {
+            let col = &block[c * rows..(c + 1) * rows];
+            let xc = top[c] / col[c];
+            top[c] = xc;
+            if xc == 0.0 {
+                continue;
+            }
+            for (xi, &v) in top[c + 1..].iter_mut().zip(&col[c + 1..w]) {
+                *xi -= v * xc;
+            }
+            for (bi, &v) in below.iter_mut().zip(&col[w..]) {
+                *bi += v * xc;
             }
         }
     }
@@ -597,6 +745,29 @@ mod tests {
             d < 1e-12,
             "sparse forward + backward differ from faer by {d:e}"
         );
+        // The split forward solve: the dense one's result to rounding, the same bits on one
+        // thread and on two.
+        let mut f = vec![0.0; n];
+        for (new, &old) in solver.permutation().iter().enumerate() {
+            f[new] = s.rhs[old];
+        }
+        let forward = |threads: usize, mut v: Vec<Real>| {
+            let mut work = ReachWork::default();
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| solver.forward(l, &mut v, &mut work));
+            v
+        };
+        let (one, two) = (forward(1, f.clone()), forward(2, f.clone()));
+        assert!(one
+            .iter()
+            .zip(&two)
+            .all(|(p, q)| p.to_bits() == q.to_bits()));
+        solver.forward_dense(l, &mut f, &mut work);
+        let d = max_rel_diff(&two, &f);
+        assert!(d < 1e-12, "split forward differs from dense by {d:e}");
         // A full right-hand side: dense forward, backward.
         let mut f = vec![0.0; n];
         for (new, &old) in solver.permutation().iter().enumerate() {
