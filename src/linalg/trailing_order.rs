@@ -144,10 +144,7 @@ mod tests {
         assert!(is_permutation(&perm, &inv));
         let (post, post_inv) = post.expect("one tree holds every candidate");
         assert!(is_permutation(&post, &post_inv));
-        assert_ne!(
-            post, perm,
-            "the lone grid's tree moves ahead of the candidates"
-        );
+        assert_ne!(post, perm, "the postorder regroups the ordering by trees");
         let m = 3 * 20;
         assert!(post[n - m..].iter().all(|&d| trailing[groups[d]]));
         assert!(post[..n - m].iter().all(|&d| !trailing[groups[d]]));
