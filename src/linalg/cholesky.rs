@@ -314,8 +314,11 @@ impl SparseCholesky {
     /// `groups[dof] = node`) ordered last and the others by METIS nested dissection, in the
     /// supernodal layout: the last block of the factor is then the Cholesky factor of the
     /// Schur complement on the trailing DOFs ([`trailing_factor`](Self::trailing_factor)).
-    /// Large bodies analysed for several threads are postordered for the tree-parallel
-    /// factorization and solves when that keeps the trailing DOFs last (one tree holds them).
+    /// Large bodies analysed for several threads take the tree path of
+    /// [`analyze_with`](Self::analyze_with) (the node graph's analysis, postordered, with the
+    /// factor's first touch overlapped, the tree-parallel factorization and solves) when its
+    /// postorder keeps the trailing DOFs last (one tree holds them); otherwise faer's analysis
+    /// of the DOF matrix, postordered for the tree plan where that keeps them last.
     pub fn analyze_trailing(
         n: usize,
         col_ptr: &[usize],
@@ -333,22 +336,50 @@ impl SparseCholesky {
         }
         let n_nodes = trailing.len();
         let (xadj, adjncy) = graph_of_pattern(n, col_ptr, row_idx, Some(groups), n_nodes)?;
-        let (node_perm, _) = nested_dissection_with_trailing(&xadj, &adjncy, trailing)?;
-        let (perm, inv) = expand_to_dofs(&node_perm, groups)?;
-        // Large bodies on several threads: postordered for the tree-parallel factorization and
-        // solves, as in `analyze_with`, where the trailing DOFs stay last.
-        let postordered = (threads != 1 && n >= MIN_TREE_DOFS)
-            .then(|| {
-                postorder_keeping_trailing(col_ptr, row_idx, &perm, &inv, |d| trailing[groups[d]])
-            })
-            .flatten();
-        let tree_parallel = postordered.is_some();
-        let custom = Some(postordered.unwrap_or((perm, inv)));
+        let (node_perm, node_inv) = nested_dissection_with_trailing(&xadj, &adjncy, trailing)?;
         let options = CholeskyOptions {
             ordering: FillOrdering::NestedDissection,
             layout: FactorLayout::Supernodal,
             threads,
         };
+        let large = threads != 1 && n >= MIN_TREE_DOFS;
+        let is_trailing = |d: usize| trailing[groups[d]];
+        let mut early = Vec::new();
+        if large {
+            // As in `analyze_with`: the factor's pages are faulted in on the other core while
+            // the node graph is analysed.
+            let mut sizes = vec![0usize; n_nodes];
+            groups.iter().for_each(|&node| sizes[node] += 1);
+            let done = AtomicBool::new(false);
+            let (prefaulted, analysed) = rayon::join(
+                || {
+                    let entries = factor_entries(&xadj, &adjncy, &node_perm, &node_inv, &sizes);
+                    prefault(entries, &done)
+                },
+                || {
+                    let analysed =
+                        node_symbolic(n, &xadj, &adjncy, &node_perm, &node_inv, Some(groups));
+                    done.store(true, AtomicOrdering::Relaxed);
+                    analysed
+                },
+            );
+            let analysed = analysed?;
+            let m = groups.iter().filter(|&&g| trailing[g]).count();
+            if analysed.perm[n - m..].iter().all(|&d| is_trailing(d)) {
+                return Self::from_nodes(n, col_ptr, row_idx, analysed, options, prefaulted);
+            }
+            // The node postorder interleaves them: faer's analysis of the ordering as it was
+            // (its buffer continues the prefaulted one).
+            early = prefaulted;
+        }
+        let (perm, inv) = expand_to_dofs(&node_perm, groups)?;
+        // Postordered for the tree-parallel factorization and solves where the trailing DOFs
+        // stay last.
+        let postordered = large
+            .then(|| postorder_keeping_trailing(col_ptr, row_idx, &perm, &inv, is_trailing))
+            .flatten();
+        let tree_parallel = postordered.is_some();
+        let custom = Some(postordered.unwrap_or((perm, inv)));
         let (pattern, symbolic) = symbolic_analysis(n, col_ptr, row_idx, custom, options)?;
         Self::from_symbolic(
             n,
@@ -358,7 +389,7 @@ impl SparseCholesky {
             symbolic,
             options,
             tree_parallel,
-            Vec::new(),
+            early,
         )
     }
 
@@ -748,24 +779,27 @@ impl SparseCholesky {
         if !self.factorized || m > self.n {
             return None;
         }
-        // analyze_trailing always analyses with faer.
-        let Structure::Faer(symbolic) = &self.structure else {
-            return None;
-        };
-        let SymbolicCholeskyRaw::Supernodal(s) = symbolic.raw() else {
-            return None;
+        let from_faer;
+        let arrays = match &self.structure {
+            Structure::Faer(symbolic) => match symbolic.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => {
+                    from_faer = SupernodeArrays::new(s);
+                    &from_faer
+                }
+                SymbolicCholeskyRaw::Simplicial(_) => return None,
+            },
+            Structure::Nodes { arrays, .. } => arrays,
         };
         let first = self.n - m;
         let mut block = faer::Mat::<f64>::zeros(m, m);
-        let bounds = s.supernode_begin().iter().zip(s.supernode_end());
-        for (k, (&start, &end)) in bounds.enumerate() {
-            if end <= first {
-                continue;
-            }
+        // Supernode k: a column-major block of (width + pattern) rows × width columns from
+        // val_ptr[k], its square diagonal block on top (faer's storage and the node path's).
+        for k in arrays.super_of.get(first).copied().unwrap_or(arrays.len())..arrays.len() {
+            let (start, end) = (arrays.begin[k], arrays.begin[k + 1]);
             let width = end - start;
-            let pattern = s.supernode(k).pattern();
+            let pattern = arrays.pattern(k);
             let rows = width + pattern.len();
-            let base = s.col_ptr_for_val()[k];
+            let base = arrays.val_ptr[k];
             for col in start.max(first)..end {
                 let c = col - start;
                 let values = &self.l_values[base + c * rows..base + (c + 1) * rows];

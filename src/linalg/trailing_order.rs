@@ -209,4 +209,78 @@ mod tests {
         assert!(ds < 1e-12, "Schur complements differ by {ds:.1e}");
         assert!(dc < 1e-12, "compliances differ by {dc:.1e}");
     }
+
+    /// A body over the tree plan's size (24 × 24 × 12 nodes, 20,736 DOFs) with a 6 × 6 patch
+    /// of one face last, analysed for two threads: it takes the node graph's analysis and the
+    /// tree path, and its trailing block gives `L₂₂ L₂₂ᵀ` equal to the Schur complement
+    /// `S = A₂₂ − A₂₁ A₁₁⁻¹ A₁₂` formed column by column from solves with `A₁₁` alone (faer's
+    /// sequential factorization of the leading DOFs, another code path), to 1e-10 of S's
+    /// largest entry.
+    #[test]
+    fn node_path_trailing_factor_is_the_factor_of_the_schur_complement() {
+        let (n, col_ptr, rows, vals, groups) = grids(&[[24, 24, 12]]);
+        assert!(n >= crate::linalg::tree_cholesky::MIN_TREE_DOFS);
+        let trailing: Vec<bool> = (0..n / 3).map(|v| v < 24 * 6 && v % 24 < 6).collect();
+        let m = 3 * 36;
+        let mut chol =
+            SparseCholesky::analyze_trailing(n, &col_ptr, &rows, &groups, &trailing, 2).unwrap();
+        assert!(chol.has_node_structure() && chol.is_tree_parallel());
+        chol.factorize(&vals).unwrap();
+        let (dofs, l) = chol.trailing_factor(m).unwrap();
+        assert!(dofs.iter().all(|&d| trailing[groups[d]]));
+        // Local numbers: leading DOFs ascending, trailing DOFs in the factor's order.
+        let mut local = vec![usize::MAX; n];
+        let leading: Vec<usize> = (0..n).filter(|&d| !trailing[groups[d]]).collect();
+        leading.iter().enumerate().for_each(|(k, &d)| local[d] = k);
+        let mut slot = vec![usize::MAX; n];
+        dofs.iter().enumerate().for_each(|(k, &d)| slot[d] = k);
+        let nl = n - m;
+        let mut e11 = Vec::new();
+        let mut a12 = vec![vec![0.0; nl]; m];
+        let mut s = faer::Mat::<f64>::zeros(m, m);
+        for c in 0..n {
+            for p in col_ptr[c]..col_ptr[c + 1] {
+                let (r, v) = (rows[p], vals[p]);
+                match (slot[r], slot[c]) {
+                    (usize::MAX, usize::MAX) => e11.push((local[r], local[c], v)),
+                    (usize::MAX, j) => a12[j][local[r]] += v,
+                    (i, usize::MAX) => a12[i][local[c]] += v,
+                    (i, j) => {
+                        s[(i, j)] = v;
+                        s[(j, i)] = v;
+                    }
+                }
+            }
+        }
+        let (c11, r11, v11) = lower_csc(nl, e11);
+        let options = crate::linalg::cholesky::CholeskyOptions {
+            threads: 1,
+            ..Default::default()
+        };
+        let mut a11 = SparseCholesky::analyze_with(nl, &c11, &r11, None, options).unwrap();
+        assert!(!a11.is_tree_parallel());
+        a11.factorize(&v11).unwrap();
+        for j in 0..m {
+            let mut x = a12[j].clone();
+            a11.solve_in_place(&mut x);
+            for i in 0..m {
+                s[(i, j)] -= a12[i].iter().zip(&x).map(|(a, b)| a * b).sum::<f64>();
+            }
+        }
+        let llt = &l * l.transpose();
+        let (mut worst, mut largest): (f64, f64) = (0.0, 0.0);
+        for j in 0..m {
+            for i in 0..m {
+                worst = worst.max((llt[(i, j)] - s[(i, j)]).abs());
+                largest = largest.max(s[(i, j)].abs());
+            }
+        }
+        eprintln!("L22 L22ᵀ − S: {:.1e} of the largest entry", worst / largest);
+        assert!(
+            worst < 1e-10 * largest,
+            "L22 L22ᵀ differs from the Schur complement by {:.1e} of its largest entry",
+            worst / largest
+        );
+        assert!((0..m).all(|i| (i + 1..m).all(|j| l[(i, j)] == 0.0)));
+    }
 }
