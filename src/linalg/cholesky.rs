@@ -970,12 +970,12 @@ fn zeroed(mut start: Vec<f64>, len: usize) -> Result<Vec<f64>, CholeskyError> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// Lower-triangle CSC of a matrix given as (row, col, value) with row ≥ col;
     /// duplicates are summed.
-    fn lower_csc(
+    pub(crate) fn lower_csc(
         n: usize,
         mut entries: Vec<(usize, usize, f64)>,
     ) -> (Vec<usize>, Vec<usize>, Vec<f64>) {

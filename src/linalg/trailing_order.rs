@@ -33,34 +33,12 @@ pub(crate) fn postorder_keeping_trailing(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::cholesky::tests::lower_csc;
     use crate::linalg::ordering::{
         expand_to_dofs, graph_of_pattern, nested_dissection_with_trailing,
     };
     use crate::linalg::SparseCholesky;
     use faer::linalg::solvers::DenseSolveCore;
-
-    /// Lower CSC (rows sorted, diagonal first) of a symmetric matrix given by `(row, col, v)`
-    /// entries with row ≥ col, duplicates summed.
-    fn lower_csc(n: usize, mut e: Vec<(usize, usize, f64)>) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
-        e.sort_by_key(|&(i, j, _)| (j, i));
-        let mut col_ptr = vec![0; n + 1];
-        let (mut rows, mut vals): (Vec<usize>, Vec<f64>) = (Vec::new(), Vec::new());
-        let mut last = None;
-        for (i, j, v) in e {
-            if last == Some((i, j)) {
-                *vals.last_mut().unwrap() += v;
-                continue;
-            }
-            last = Some((i, j));
-            rows.push(i);
-            vals.push(v);
-            col_ptr[j + 1] += 1;
-        }
-        for j in 0..n {
-            col_ptr[j + 1] += col_ptr[j];
-        }
-        (col_ptr, rows, vals)
-    }
 
     /// Grids of `nx × ny × nz` nodes, one after another (separate components), 3 DOFs per
     /// node coupled to the 6 neighbours by 3 × 3 blocks (`groups[dof] = node`): an SPD matrix
