@@ -259,29 +259,8 @@ impl SupernodalSolver {
         x: &mut [Real],
         below: &mut Vec<Real>,
     ) {
-        let (sb, se) = (self.begin[k], self.begin[k + 1]);
-        let w = se - sb;
-        let pat = self.pattern(k);
-        let rows = w + pat.len();
-        let block = &l[self.val_ptr[k]..self.val_ptr[k + 1]];
-        below.clear();
-        below.resize(pat.len(), 0.0);
-        let top = &mut x[sb..se];
-        for c in c0..w {
-            let col = &block[c * rows..(c + 1) * rows];
-            let xc = top[c] / col[c];
-            top[c] = xc;
-            if xc == 0.0 {
-                continue;
-            }
-            for (xi, &v) in top[c + 1..].iter_mut().zip(&col[c + 1..w]) {
-                *xi -= v * xc;
-            }
-            for (bi, &v) in below.iter_mut().zip(&col[w..]) {
-                *bi += v * xc;
-            }
-        }
-        for (&r, &b) in pat.iter().zip(below.iter()) {
+        self.forward_block(k, c0, l, x, 0, below);
+        for (&r, &b) in self.pattern(k).iter().zip(below.iter()) {
             x[r] -= b;
         }
     }
@@ -414,7 +393,7 @@ impl SupernodalSolver {
             }
         }
         for s in chain_start..=k {
-            self.forward_block(s, l, local, lo, below);
+            self.forward_block(s, 0, l, local, lo, below);
             let pat = self.pattern(s);
             self.scatter_out(pat, below, local, lo, outside, out);
         }
@@ -446,11 +425,13 @@ impl SupernodalSolver {
         }
     }
 
-    /// The forward solve of supernode `k`'s own columns in `local` (rows from `lo` on), and
-    /// in `below` the products of its rows below them with those columns.
+    /// The forward solve of supernode `k`'s own columns from its column `c0` on (the ones
+    /// before are zero) in `local` (rows from `lo` on), and in `below` the products of its
+    /// rows below them with those columns.
     fn forward_block(
         &self,
         k: usize,
+        c0: usize,
         l: &[f64],
         local: &mut [Real],
         lo: usize,
@@ -464,7 +445,7 @@ impl SupernodalSolver {
         below.clear();
         below.resize(pat.len(), 0.0);
         let top = &mut local[sb - lo..se - lo];
-        for c in 0..w {
+        for c in c0..w {
             let col = &block[c * rows..(c + 1) * rows];
             let xc = top[c] / col[c];
             top[c] = xc;
