@@ -33,6 +33,36 @@ pub enum OrderingError {
     InvalidGroups(String),
 }
 
+/// METIS options for one nested dissection; `None` keeps METIS's default.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct MetisOptions {
+    /// Seed of METIS's random generator (METIS's default −1 means 4321).
+    pub seed: Option<i32>,
+    /// Allowed imbalance of a separator's two sides, in thousandths above 1 (METIS's
+    /// default for nested dissection: 200, i.e. 1.2).
+    pub ufactor: Option<i32>,
+}
+
+impl std::fmt::Display for MetisOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match (self.seed, self.ufactor) {
+            (None, None) => write!(f, "METIS defaults"),
+            (Some(s), None) => write!(f, "METIS seed {s}"),
+            (None, Some(u)) => write!(f, "METIS ufactor {u}"),
+            (Some(s), Some(u)) => write!(f, "METIS seed {s}, ufactor {u}"),
+        }
+    }
+}
+
+/// The second nested dissection tried on the tree path, side by side with METIS's defaults
+/// (see [`best_of_two_orderings`]): another seed, i.e. another draw of the same method. Of
+/// the settings direct3 and direct4 measured, only another seed gains on some lattices
+/// without being a systematic change; taking the cheaper of the two never loses.
+pub const SECOND_ORDERING: MetisOptions = MetisOptions {
+    seed: Some(1),
+    ufactor: None,
+};
+
 /// Nested-dissection ordering of a graph given as CSR adjacency (`xadj` of length
 /// `n + 1`, neighbours of vertex `v` in `adjncy[xadj[v]..xadj[v + 1]]`).
 ///
@@ -44,6 +74,15 @@ pub fn nested_dissection(
     xadj: &[usize],
     adjncy: &[usize],
 ) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
+    nested_dissection_with(xadj, adjncy, MetisOptions::default())
+}
+
+/// [`nested_dissection`] with METIS options other than its defaults.
+pub fn nested_dissection_with(
+    xadj: &[usize],
+    adjncy: &[usize],
+    options: MetisOptions,
+) -> Result<(Vec<usize>, Vec<usize>), OrderingError> {
     let n = check_csr(xadj, adjncy)?;
     let mut graph = MetisGraph::new(n, xadj, adjncy)?;
     // No edges: every order is fill-free, and METIS gains nothing.
@@ -51,7 +90,7 @@ pub fn nested_dissection(
         let identity: Vec<usize> = (0..n).collect();
         return Ok((identity.clone(), identity));
     }
-    let (perm, inv) = metis_node_nd(&mut graph)?;
+    let (perm, inv) = metis_node_nd(&mut graph, options)?;
     let perm: Vec<usize> = perm.iter().map(|&p| p as usize).collect();
     let inv: Vec<usize> = inv.iter().map(|&p| p as usize).collect();
     // A wrong permutation from C would corrupt the factorization silently: check it once.
@@ -207,6 +246,17 @@ pub fn expand_to_dofs(
     Ok((perm, inv))
 }
 
+/// The size of a Cholesky factor and the work of computing it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FactorCost {
+    /// Entries of L's lower triangle, diagonal included.
+    pub entries: usize,
+    /// Σ over the factor's columns of (entries in the column)², the multiply-adds of a
+    /// column-by-column factorization up to lower-order terms (for a dense block of w
+    /// columns over p rows, w³/3 + w²p + wp² as the supernodal count has it).
+    pub flops: f64,
+}
+
 /// Entries of the Cholesky factor's lower triangle (diagonal included) when the graph's
 /// vertices are eliminated in the order `perm` (`perm[new] = old`, `inv[old] = new`) and
 /// vertex `v` stands for a dense block of `sizes[v]` rows and columns (the DOFs of a node):
@@ -222,6 +272,19 @@ pub fn factor_entries(
     inv: &[usize],
     sizes: &[usize],
 ) -> usize {
+    factor_cost(xadj, adjncy, perm, inv, sizes).entries
+}
+
+/// [`factor_entries`] and the factorization's flops ([`FactorCost`]) from the same column
+/// counts: a node of `s` DOFs with `b` rows below its diagonal block has columns of
+/// `b + s, b + s − 1, …, b + 1` entries.
+pub fn factor_cost(
+    xadj: &[usize],
+    adjncy: &[usize],
+    perm: &[usize],
+    inv: &[usize],
+    sizes: &[usize],
+) -> FactorCost {
     const NONE: usize = usize::MAX;
     let n = perm.len();
     let mut parent = vec![NONE; n];
@@ -244,12 +307,70 @@ pub fn factor_entries(
             }
         }
     }
-    (0..n)
-        .map(|k| {
-            let s = sizes[perm[k]];
-            s * (s + 1) / 2 + s * below[k]
+    // Exact integer sums: the comparison of two orderings does not depend on rounding order.
+    let (mut entries, mut flops) = (0usize, 0u128);
+    for k in 0..n {
+        let (s, b) = (sizes[perm[k]], below[k]);
+        entries += s * (s + 1) / 2 + s * b;
+        flops += (1..=s).map(|c| ((b + c) as u128).pow(2)).sum::<u128>();
+    }
+    FactorCost {
+        entries,
+        flops: flops as f64,
+    }
+}
+
+/// A nested dissection chosen among two by its factorization's flops.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChosenOrdering {
+    /// `perm[new] = old` over the graph's vertices.
+    pub perm: Vec<usize>,
+    /// `inv[old] = new`.
+    pub inv: Vec<usize>,
+    /// The chosen ordering's factor.
+    pub cost: FactorCost,
+    /// The other ordering's factor.
+    pub other: FactorCost,
+    /// Whether the chosen one is the second ordering (else METIS's defaults).
+    pub second_chosen: bool,
+}
+
+/// Nested dissections with METIS's defaults and with `second`, computed side by side (METIS
+/// keeps its random generator per thread, so each is what it would be alone), and the one
+/// whose factor ([`factor_cost`], vertex `v` a block of `sizes[v]` DOFs) takes fewer flops;
+/// the defaults on a tie. The same graph gives the same choice on any thread count.
+pub fn best_of_two_orderings(
+    xadj: &[usize],
+    adjncy: &[usize],
+    sizes: &[usize],
+    second: MetisOptions,
+) -> Result<ChosenOrdering, OrderingError> {
+    let order = |options: MetisOptions| {
+        nested_dissection_with(xadj, adjncy, options).map(|(perm, inv)| {
+            let cost = factor_cost(xadj, adjncy, &perm, &inv, sizes);
+            (perm, inv, cost)
         })
-        .sum()
+    };
+    let (first, other) = rayon::join(|| order(MetisOptions::default()), || order(second));
+    let (p0, i0, c0) = first?;
+    let (p1, i1, c1) = other?;
+    Ok(if c1.flops < c0.flops {
+        ChosenOrdering {
+            perm: p1,
+            inv: i1,
+            cost: c1,
+            other: c0,
+            second_chosen: true,
+        }
+    } else {
+        ChosenOrdering {
+            perm: p0,
+            inv: i0,
+            cost: c0,
+            other: c1,
+            second_chosen: false,
+        }
+    })
 }
 
 /// A graph METIS may safely read: symmetric, no self loops or duplicate edges, offsets
@@ -271,34 +392,48 @@ impl MetisGraph {
     }
 }
 
-/// Calls `METIS_NodeND` with default options and returns its `(perm, iperm)`.
+/// Calls `METIS_NodeND` with `options` and returns its `(perm, iperm)`.
 ///
 /// This is the crate's only `unsafe`. Its soundness rests on [`MetisGraph`]: METIS does
 /// not validate its input, so it only ever sees a graph built by `MetisGraph::new`.
-fn metis_node_nd(graph: &mut MetisGraph) -> Result<(Vec<idx_t>, Vec<idx_t>), OrderingError> {
+/// Calls may run side by side: the METIS built here (third_party/metis-sys) keeps its random
+/// generator per thread, re-seeded at each call, so each ordering is the one it is alone.
+fn metis_node_nd(
+    graph: &mut MetisGraph,
+    options: MetisOptions,
+) -> Result<(Vec<idx_t>, Vec<idx_t>), OrderingError> {
     let n = graph.xadj.len() - 1;
     let mut nvtxs = idx_t::try_from(n).map_err(|_| too_large("vertices", n))?;
     let mut perm: Vec<idx_t> = vec![0; n];
     let mut iperm: Vec<idx_t> = vec![0; n];
-    // METIS draws its random choices from one process-wide generator, re-seeded at each call:
-    // two calls at once (bodies analysed side by side, scenes of a batch) would interleave
-    // its draws and each get another ordering than alone, so runs would differ in the last
-    // bits. One call at a time keeps every ordering the one it is alone. A poisoned lock only
-    // means another call panicked; the generator is re-seeded anyway.
-    static METIS: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    let _one_at_a_time = METIS.lock().unwrap_or_else(|e| e.into_inner());
+    // METIS's defaults by a null pointer, as before options existed (the same ordering).
+    let mut metis_options = (options != MetisOptions::default()).then(|| {
+        let mut o: Vec<idx_t> = vec![-1; metis_sys::METIS_NOPTIONS as usize];
+        o[metis_sys::moptions_et_METIS_OPTION_NUMBERING as usize] = 0;
+        if let Some(seed) = options.seed {
+            o[metis_sys::moptions_et_METIS_OPTION_SEED as usize] = seed;
+        }
+        if let Some(ufactor) = options.ufactor {
+            o[metis_sys::moptions_et_METIS_OPTION_UFACTOR as usize] = ufactor;
+        }
+        o
+    });
+    let options_ptr = metis_options
+        .as_mut()
+        .map_or(std::ptr::null_mut(), |o| o.as_mut_ptr());
     // SAFETY: `nvtxs` is the vertex count, `xadj` has `nvtxs + 1` offsets ending at
     // `adjncy.len()`, every neighbour is a valid vertex and the graph is symmetric
     // without self loops (all by construction of `MetisGraph`); `perm` and `iperm` hold
-    // `nvtxs` entries each; null `vwgt` and `options` select unit weights and METIS's
-    // defaults (0-based numbering). METIS keeps no pointer after returning.
+    // `nvtxs` entries each; a null `vwgt` selects unit weights; `options` is null (METIS's
+    // defaults) or METIS_NOPTIONS entries, −1 (default) but for 0-based numbering and the
+    // values asked for. METIS keeps no pointer after returning.
     let status = unsafe {
         metis_sys::METIS_NodeND(
             &mut nvtxs,
             graph.xadj.as_mut_ptr(),
             graph.adjncy.as_mut_ptr(),
             std::ptr::null_mut(),
-            std::ptr::null_mut(),
+            options_ptr,
             perm.as_mut_ptr(),
             iperm.as_mut_ptr(),
         )
@@ -496,7 +631,7 @@ mod tests {
     fn metis_node_nd_orders_a_grid() {
         let (xadj, adj) = grid(7, 5);
         let mut graph = MetisGraph::new(35, &xadj, &adj).unwrap();
-        let (perm, iperm) = metis_node_nd(&mut graph).unwrap();
+        let (perm, iperm) = metis_node_nd(&mut graph, MetisOptions::default()).unwrap();
         let perm: Vec<usize> = perm.iter().map(|&p| p as usize).collect();
         let iperm: Vec<usize> = iperm.iter().map(|&p| p as usize).collect();
         assert_perm_pair(&perm, &iperm, 35);
@@ -575,6 +710,151 @@ mod tests {
             factor_entries(&x, &a, &perm, &inv, &[2, 1, 1, 1]),
             3 + 3 + 6
         );
+    }
+
+    extern "C" {
+        // GKlib's generator as METIS calls it (third_party/metis-sys/vendor/GKlib/random.c).
+        fn gk_randinit(seed: u64);
+        fn gk_randint32() -> u32;
+    }
+
+    /// METIS's per-thread generator draws glibc's `rand()` (= `random()`) sequence after `srand(seed)`, so
+    /// every ordering is bitwise the one METIS gave with libc's process-wide generator.
+    #[test]
+    fn metis_generator_is_glibcs_rand() {
+        for seed in [0u32, 1, 4321, 12345, 0x8000_0005, u32::MAX] {
+            // SAFETY: GKlib's generator only touches this thread's state; glibc's
+            // srand/rand (= srandom/random) lock their state and nothing else here draws from it.
+            let (ours, glibc): (Vec<u32>, Vec<u32>) = unsafe {
+                gk_randinit(u64::from(seed));
+                libc::srand(seed);
+                (0..10_000)
+                    .map(|_| (gk_randint32(), libc::rand() as u32))
+                    .unzip()
+            };
+            assert_eq!(ours, glibc, "seed {seed}");
+        }
+    }
+
+    /// Node graph of an nx × ny × nz lattice whose nodes join their 26 neighbours.
+    fn lattice_graph(nx: usize, ny: usize, nz: usize) -> (Vec<usize>, Vec<usize>) {
+        let id = |x: usize, y: usize, z: usize| (z * ny + y) * nx + x;
+        let mut xadj = vec![0];
+        let mut adj = Vec::new();
+        for z in 0..nz {
+            for y in 0..ny {
+                for x in 0..nx {
+                    for (dx, dy, dz) in (0..27).map(|k| (k % 3, k / 3 % 3, k / 9)) {
+                        let (u, v, w) = (
+                            (x + dx).wrapping_sub(1),
+                            (y + dy).wrapping_sub(1),
+                            (z + dz).wrapping_sub(1),
+                        );
+                        if (dx, dy, dz) != (1, 1, 1) && u < nx && v < ny && w < nz {
+                            adj.push(id(u, v, w));
+                        }
+                    }
+                    xadj.push(adj.len());
+                }
+            }
+        }
+        (xadj, adj)
+    }
+
+    /// Four threads ordering four different graphs at once, several times, get each graph's
+    /// ordering alone (before the per-thread generator they interleaved one libc state).
+    #[test]
+    fn orderings_side_by_side_are_the_sequential_ones() {
+        let graphs = [
+            lattice_graph(14, 12, 11),
+            lattice_graph(9, 17, 13),
+            lattice_graph(20, 10, 8),
+            lattice_graph(12, 12, 12),
+        ];
+        let options = [
+            MetisOptions::default(),
+            SECOND_ORDERING,
+            MetisOptions::default(),
+            MetisOptions {
+                seed: Some(7),
+                ufactor: Some(50),
+            },
+        ];
+        let alone: Vec<_> = graphs
+            .iter()
+            .zip(options)
+            .map(|((x, a), o)| nested_dissection_with(x, a, o).unwrap())
+            .collect();
+        for _ in 0..4 {
+            let together: Vec<_> = std::thread::scope(|scope| {
+                let handles: Vec<_> = graphs
+                    .iter()
+                    .zip(options)
+                    .map(|((x, a), o)| scope.spawn(move || nested_dissection_with(x, a, o)))
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| h.join().unwrap().unwrap())
+                    .collect()
+            });
+            assert_eq!(together, alone);
+        }
+        // The options reach METIS: another seed gives another ordering of the same graph.
+        let (x, a) = &graphs[0];
+        assert_ne!(
+            nested_dissection_with(x, a, SECOND_ORDERING).unwrap(),
+            nested_dissection(x, a).unwrap()
+        );
+    }
+
+    #[test]
+    fn factor_cost_by_hand() {
+        // Path 0-1-2-3, one DOF per vertex, natural order: columns of 2, 2, 2, 1 entries.
+        let (x, a) = (vec![0, 1, 3, 5, 6], vec![1, 0, 2, 1, 3, 2]);
+        let id = [0, 1, 2, 3];
+        let c = factor_cost(&x, &a, &id, &id, &[1; 4]);
+        assert_eq!((c.entries, c.flops), (7, 13.0));
+        // Two DOFs per vertex: a vertex with b rows below has columns of b + 2 and b + 1.
+        // Three vertices with b = 2 (16 + 9 each), the last with b = 0 (4 + 1).
+        let c = factor_cost(&x, &a, &id, &id, &[2; 4]);
+        assert_eq!((c.entries, c.flops), (4 * 3 + 3 * 4, 3.0 * 25.0 + 5.0));
+        // Star with its centre first: the leaves fill into a clique, columns of 4, 3, 2, 1.
+        let (x, a) = (vec![0, 3, 4, 5, 6], vec![1, 2, 3, 0, 0, 0]);
+        let c = factor_cost(&x, &a, &id, &id, &[1; 4]);
+        assert_eq!((c.entries, c.flops), (10, 30.0));
+    }
+
+    /// The choice is the ordering with fewer flops, the same on repeated calls, and its cost
+    /// is that ordering's own.
+    #[test]
+    fn best_of_two_takes_the_cheaper_ordering() {
+        let (x, a) = lattice_graph(14, 12, 11);
+        let sizes = vec![3; 14 * 12 * 11];
+        let chosen = best_of_two_orderings(&x, &a, &sizes, SECOND_ORDERING).unwrap();
+        let (p0, i0) = nested_dissection(&x, &a).unwrap();
+        let (p1, i1) = nested_dissection_with(&x, &a, SECOND_ORDERING).unwrap();
+        let (c0, c1) = (
+            factor_cost(&x, &a, &p0, &i0, &sizes),
+            factor_cost(&x, &a, &p1, &i1, &sizes),
+        );
+        assert_ne!(c0.flops, c1.flops, "pick a graph where the two differ");
+        let (expected, cost, other) = if c1.flops < c0.flops {
+            (p1, c1, c0)
+        } else {
+            (p0, c0, c1)
+        };
+        assert_eq!(chosen.perm, expected);
+        assert_eq!(chosen.second_chosen, c1.flops < c0.flops);
+        assert_eq!((chosen.cost, chosen.other), (cost, other));
+        assert!(is_inverse_pair(&chosen.perm, &chosen.inv));
+        assert_eq!(
+            best_of_two_orderings(&x, &a, &sizes, SECOND_ORDERING).unwrap(),
+            chosen
+        );
+        // The same options twice: a tie, and the defaults win it.
+        let tie = best_of_two_orderings(&x, &a, &sizes, MetisOptions::default()).unwrap();
+        assert!(!tie.second_chosen);
+        assert_eq!(tie.cost, tie.other);
     }
 
     #[test]
