@@ -363,6 +363,7 @@ pub(crate) fn bench_cholmod(
     use linkage::bench::cholmod::{
         lattice_system, load_average, system_npz, time_direct, COMPARE_SCRIPT,
     };
+    use linkage::linalg::ordering::{MetisOptions, SECOND_ORDERING};
     let sizes = if cells.is_empty() {
         vec![[20, 20, 40], [40, 40, 40]]
     } else {
@@ -408,6 +409,22 @@ pub(crate) fn bench_cholmod(
                     time_direct(&system, Default::default(), false).map_err(anyhow::Error::msg)?;
                 if rep == 1 {
                     fills = (ours.nnz_l, theirs.nnz_l);
+                    if let Some(o) = ours.orderings {
+                        let (first, second) = (MetisOptions::default(), SECOND_ORDERING);
+                        let (kept, other) = match o.second_chosen {
+                            true => (second, first),
+                            false => (first, second),
+                        };
+                        println!(
+                            "{name}: analysis: ordering {kept} kept, {:.4e} flops (nnz(L) {}) \
+                             against {other}'s {:.4e} ({}) on the node graph; supernodal flops {}",
+                            o.chosen.flops,
+                            o.chosen.entries,
+                            o.other.flops,
+                            o.other.entries,
+                            ours.flops.map_or("?".to_string(), |f| format!("{f:.4e}")),
+                        );
+                    }
                 }
                 println!(
                     "{:<10} {:>3} {:>9} | {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>6.2}s {:>8.1e} | {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>6.2}s {:>8.1e} | {:>6.3} {:>5}",

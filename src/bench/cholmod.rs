@@ -5,7 +5,7 @@
 //! it and times scikit-sparse's CHOLMOD. Our side times the same phases in this process:
 //! ordering + symbolic analysis, numeric factorization, one solve.
 
-use crate::linalg::cholesky::{CholeskyOptions, SparseCholesky};
+use crate::linalg::cholesky::{CholeskyOptions, OrderingChoice, SparseCholesky};
 use crate::linalg::SymmetricCsr;
 use crate::linkage::generators::lattice_body;
 use crate::linkage::{linear_member_block, DofMap, StiffnessAssembly};
@@ -103,6 +103,10 @@ pub struct DirectTiming {
     pub residual: Real,
     /// Entries of L.
     pub nnz_l: usize,
+    /// The two nested dissections the tree path chose from (`None` off the tree path).
+    pub orderings: Option<OrderingChoice>,
+    /// Flops of the factorization by its supernodes (`None` when simplicial).
+    pub flops: Option<Real>,
 }
 
 impl DirectTiming {
@@ -139,6 +143,7 @@ pub fn time_direct(
     let solve = t.elapsed().as_secs_f64();
     let cpu = cpu_seconds() - cpu0;
     let nnz_l = c.stats().nnz_l;
+    let (orderings, flops) = (c.ordering_choice(), c.factor_flops());
     drop(c);
     Ok(DirectTiming {
         analyze,
@@ -147,6 +152,8 @@ pub fn time_direct(
         cpu,
         residual: relative_residual(s, &x),
         nnz_l,
+        orderings,
+        flops,
     })
 }
 

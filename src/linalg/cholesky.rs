@@ -18,8 +18,8 @@ use std::sync::atomic::{AtomicBool, Ordering as AtomicOrdering};
 
 use super::node_symbolic::{node_symbolic, NodeSymbolic};
 use super::ordering::{
-    expand_to_dofs, factor_entries, graph_of_pattern, nested_dissection,
-    nested_dissection_with_trailing, OrderingError,
+    best_of_two_orderings, expand_to_dofs, factor_entries, graph_of_pattern, nested_dissection,
+    nested_dissection_with_trailing, FactorCost, OrderingError, SECOND_ORDERING,
 };
 use super::trailing_order::postorder_keeping_trailing;
 use super::tree_cholesky::{SupernodeArrays, TreePlan, MIN_TREE_DOFS};
@@ -161,9 +161,24 @@ pub struct SparseCholesky {
     tree: Option<TreePlan>,
     pivot_tolerance: f64,
     ordering: FillOrdering,
+    /// The two nested dissections tried on the tree path (`None` elsewhere).
+    orderings: Option<OrderingChoice>,
     factorized: bool,
     /// `l_values` holds only zeros (nothing factored into it since the analysis).
     l_zero: bool,
+}
+
+/// The two nested dissections [`SparseCholesky::analyze_with`] orders a large body with on
+/// several threads (METIS's defaults and [`SECOND_ORDERING`]), by their factors on the node
+/// graph.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrderingChoice {
+    /// The kept ordering's factor (the one with fewer flops; METIS's defaults on a tie).
+    pub chosen: FactorCost,
+    /// The other ordering's factor.
+    pub other: FactorCost,
+    /// Whether the kept one is [`SECOND_ORDERING`] (else METIS's defaults).
+    pub second_chosen: bool,
 }
 
 /// The factor's symbolic structure and what solves with it.
@@ -258,33 +273,42 @@ impl SparseCholesky {
             FillOrdering::NestedDissection => {
                 let n_nodes = groups.map_or(n, |g| g.iter().max().map_or(0, |&m| m + 1));
                 let (xadj, adjncy) = graph_of_pattern(n, col_ptr, row_idx, groups, n_nodes)?;
-                let (node_perm, node_inv) = nested_dissection(&xadj, &adjncy)?;
                 if tree_parallel {
-                    // The factor's pages are faulted in on the other core while the ordering
-                    // is postordered and analysed (the first touch of a 2 GB factor takes
-                    // about as long as the analysis itself), up to its size as the node
-                    // graph gives it.
                     let mut sizes = vec![0usize; n_nodes];
                     match groups {
                         Some(g) => g.iter().for_each(|&node| sizes[node] += 1),
                         None => sizes.fill(1),
                     }
+                    // Two nested dissections side by side (one per core), the cheaper kept:
+                    // the factorization is at the machine's dense rate, so fewer flops is
+                    // what makes it faster, and METIS's draws vary the flops by 2–4%.
+                    let chosen = best_of_two_orderings(&xadj, &adjncy, &sizes, SECOND_ORDERING)?;
+                    let (node_perm, node_inv) = (&chosen.perm, &chosen.inv);
+                    // The factor's pages are faulted in on the other core while the ordering
+                    // is postordered and analysed (the first touch of a 2 GB factor takes
+                    // about as long as the analysis itself), up to its size as the node
+                    // graph gives it.
+                    let entries = chosen.cost.entries;
                     let done = AtomicBool::new(false);
                     let (early, analysed) = rayon::join(
-                        || {
-                            let entries =
-                                factor_entries(&xadj, &adjncy, &node_perm, &node_inv, &sizes);
-                            prefault(entries, &done)
-                        },
+                        || prefault(entries, &done),
                         || {
                             let analysed =
-                                node_symbolic(n, &xadj, &adjncy, &node_perm, &node_inv, groups);
+                                node_symbolic(n, &xadj, &adjncy, node_perm, node_inv, groups);
                             done.store(true, AtomicOrdering::Relaxed);
                             analysed
                         },
                     );
-                    return Self::from_nodes(n, col_ptr, row_idx, analysed?, options, early);
+                    let mut solver =
+                        Self::from_nodes(n, col_ptr, row_idx, analysed?, options, early)?;
+                    solver.orderings = Some(OrderingChoice {
+                        chosen: chosen.cost,
+                        other: chosen.other,
+                        second_chosen: chosen.second_chosen,
+                    });
+                    return Ok(solver);
                 }
+                let (node_perm, node_inv) = nested_dissection(&xadj, &adjncy)?;
                 Some(match groups {
                     Some(g) => expand_to_dofs(&node_perm, g)?,
                     None => (node_perm, node_inv),
@@ -464,6 +488,7 @@ impl SparseCholesky {
             tree: Some(tree),
             pivot_tolerance: DEFAULT_PIVOT_TOLERANCE,
             ordering: options.ordering,
+            orderings: None,
             factorized: false,
             l_zero: true,
         })
@@ -532,6 +557,7 @@ impl SparseCholesky {
             tree,
             pivot_tolerance: DEFAULT_PIVOT_TOLERANCE,
             ordering: options.ordering,
+            orderings: None,
             factorized: false,
             l_zero: true,
         })
@@ -734,6 +760,13 @@ impl SparseCholesky {
     /// and p rows below them); `None` when simplicial.
     pub fn factor_flops(&self) -> Option<f64> {
         self.supernode_arrays().map(|a| a.flops())
+    }
+
+    /// The two nested dissections the analysis chose from, with their factors' sizes and
+    /// flops on the node graph; `None` unless it took the tree path of
+    /// [`analyze_with`](Self::analyze_with).
+    pub fn ordering_choice(&self) -> Option<OrderingChoice> {
+        self.orderings
     }
 
     /// Whether the factor's structure comes from the node graph (the tree path's own
@@ -1420,6 +1453,69 @@ pub(crate) mod tests {
             factor_entries(&x, &a, &perm, &inv, &sizes),
             chol.stats().nnz_l
         );
+    }
+
+    /// On the tree path the analysis keeps the cheaper of METIS's default ordering and
+    /// [`SECOND_ORDERING`], whatever the thread count the two METIS calls get: the same
+    /// ordering, factor sizes and solution bits on a pool of one thread and of two.
+    #[test]
+    fn tree_path_keeps_the_cheaper_of_two_orderings() {
+        // 16×16×25 cells: 21,675 DOFs, above MIN_TREE_DOFS.
+        let (s, _) = crate::bench::cholmod::lattice_system([16, 16, 25]).unwrap();
+        assert!(s.n >= MIN_TREE_DOFS);
+        let groups = s.groups.clone().unwrap();
+        let options = CholeskyOptions {
+            threads: 2,
+            ..Default::default()
+        };
+        let run = |pool_threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(pool_threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut chol = SparseCholesky::analyze_with(
+                    s.n,
+                    &s.col_ptr,
+                    &s.row_idx,
+                    Some(&groups),
+                    options,
+                )
+                .unwrap();
+                chol.factorize(&s.values).unwrap();
+                let mut x = s.rhs.clone();
+                chol.solve_in_place(&mut x);
+                (chol.permutation().to_vec(), chol.ordering_choice(), x)
+            })
+        };
+        let (perm, choice, x) = run(2);
+        let choice = choice.expect("the tree path records its two orderings");
+        assert!(choice.chosen.flops <= choice.other.flops);
+        // The recorded costs are those of the two METIS orderings of the node graph.
+        let n_nodes = groups.iter().max().unwrap() + 1;
+        let (gx, ga) =
+            graph_of_pattern(s.n, &s.col_ptr, &s.row_idx, Some(&groups), n_nodes).unwrap();
+        let mut sizes = vec![0; n_nodes];
+        groups.iter().for_each(|&g| sizes[g] += 1);
+        let cost = |o| {
+            let (p, i) = crate::linalg::ordering::nested_dissection_with(&gx, &ga, o).unwrap();
+            crate::linalg::ordering::factor_cost(&gx, &ga, &p, &i, &sizes)
+        };
+        let (first, second) = (cost(Default::default()), cost(SECOND_ORDERING));
+        let expected = match choice.second_chosen {
+            true => (second, first),
+            false => (first, second),
+        };
+        assert_eq!((choice.chosen, choice.other), expected);
+        // The residual of the solve with the chosen ordering.
+        let r = rel_err(&sym_mul(&s.col_ptr, &s.row_idx, &s.values, &x), &s.rhs);
+        assert!(r < 1e-12, "residual {r}");
+        // One thread for both METIS calls, and again on two: the same bits.
+        for threads in [1, 2] {
+            let (p, c, y) = run(threads);
+            assert_eq!((p, c), (perm.clone(), Some(choice)));
+            assert!(y.iter().zip(&x).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
     }
 
     #[test]
