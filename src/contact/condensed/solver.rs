@@ -410,6 +410,7 @@ impl CondensedSolver {
                 Some(_) if self.follow_slip => slip_axes(&n, &tangential.force, dims),
                 _ => contact_axes(&n, dims),
             };
+            let (key, _) = friction_key(&e.contact);
             let first = rows.len();
             let mut added = Vec::with_capacity(axes.len());
             for axis in &axes {
@@ -431,6 +432,7 @@ impl CondensedSolver {
                         count: axes.len(),
                         axis: *axis,
                         slipping,
+                        contact: Some(key),
                     }),
                 });
             }
@@ -606,10 +608,12 @@ impl CondensedSolver {
         normals: &mut HashMap<ActiveContact, Vector3<Real>>,
         times: &mut PhaseTimes,
     ) -> Result<Option<(usize, bool)>, ContactError> {
+        // A large set's Jacobian with friction is kept across contact sets too: the rows of
+        // contacts that come or go are taken into its factor (see `ContactJacobian::adopt`).
         let mut jacobian = self
             .jacobian
             .take()
-            .filter(|(s, _)| s == p.set)
+            .filter(|(s, j)| s == p.set || carries(j))
             .map(|(_, j)| j);
         let result = self.newton_with(p, parts, normals, times, &mut jacobian);
         self.jacobian = jacobian.map(|j| (p.set.clone(), j));
@@ -809,7 +813,8 @@ impl CondensedSolver {
                 // the cube of their rows).
                 reuse = slow < FRICTION_SLOW_ITERATIONS
                     && ((fast && j.same_states(&residual.rows))
-                        || j.restiffen(&views, &residual.rows));
+                        || j.restiffen(&views, &residual.rows)
+                        || j.adopt(&views, &residual.rows, fast));
             }
             let fresh_factor = !reuse;
             if !reuse {
@@ -960,6 +965,12 @@ impl CondensedSolver {
     }
 }
 
+/// Whether a Jacobian is kept for another contact set: with friction, from
+/// [`approximate_from`] rows (below, the exact path forms one per set, as it always has).
+fn carries(j: &ContactJacobian) -> bool {
+    j.has_friction() && j.rows().len() >= approximate_from()
+}
+
 /// Tolerances below which a large set's held contacts beyond μ f_N are let go (see the
 /// Newton loop), before convergence.
 const LOOSE_RELEASE: Real = 1e4;
@@ -1013,7 +1024,7 @@ pub(crate) fn take_record() -> Vec<Recorded> {
 }
 
 /// Whether `LINKAGE_TRACE_FRICTION` is set: each condensed Newton iteration is printed.
-fn trace() -> bool {
+pub(crate) fn trace() -> bool {
     static TRACE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
     *TRACE.get_or_init(|| std::env::var_os("LINKAGE_TRACE_FRICTION").is_some())
 }
