@@ -86,6 +86,10 @@ fn the_large_set_mode_converges_to_the_exact_paths_answer_on_the_sheared_pair() 
     let (large, record) = run(1);
     let carried = take_carried();
     println!("contact sets taken into a kept Jacobian: {carried}");
+    assert!(
+        carried > 0,
+        "the contact set never changed on a kept Jacobian"
+    );
     let approximate: Vec<&Recorded> = record.iter().filter(|r| r.approximate).collect();
     assert!(
         approximate.len() >= 5,

@@ -811,7 +811,7 @@ impl CondensedSolver {
                 // While Newton converges fast and no contact starts or stops slipping, the
                 // slipping contacts' stiffnesses are kept too (their Schur complement costs
                 // the cube of their rows).
-                reuse = slow < FRICTION_SLOW_ITERATIONS
+                reuse = slow < slow_limit(j)
                     && ((fast && j.same_states(&residual.rows))
                         || j.restiffen(&views, &residual.rows)
                         || j.adopt(&views, &residual.rows, fast));
@@ -1075,6 +1075,21 @@ fn reversals(h: &Holding, at: &[FrictionState], trial: &[FrictionState]) -> Vec<
 /// Slow iterations (a residual not below a tenth of the one before) a Jacobian with friction
 /// is kept for, its contacts' stiffnesses brought up to date, before it is formed again.
 const FRICTION_SLOW_ITERATIONS: usize = 3;
+
+/// Slow iterations a kept approximate factor (large sets) is kept for: it is kept across
+/// contact sets too, and its iterations (20-50 ms at full size) cost a twentieth of a fresh
+/// factor, so it is given more of them. Measured on `bench_contact --friction` (full size, load
+/// 5-6): 3, 6 and 10 made 10, 7 and 5 fresh factors in steps 1-4, 35.9, 27.5 and 28.2 s.
+const FRICTION_SLOW_APPROXIMATE: usize = 10;
+
+/// How many slow iterations the kept Jacobian `j` is kept for.
+fn slow_limit(j: &ContactJacobian) -> usize {
+    if j.is_approximate() {
+        FRICTION_SLOW_APPROXIMATE
+    } else {
+        FRICTION_SLOW_ITERATIONS
+    }
+}
 
 /// A friction Newton that seems to stall above this many tolerances with a kept Jacobian is
 /// given a fresh one first (the 20,000-node pair's floor is about 10 tolerances).
