@@ -458,8 +458,8 @@ impl FrictionInverse {
     }
 }
 
-/// `G_left C G_rightᵀ` for two lists of contact rows (N⁻¹·m... m/N, the rows' relative
-/// motion per unit force of the others): `W_b = C_b G_b,rightᵀ` per body touched, then each
+/// `G_left C G_rightᵀ` for two lists of contact rows (m/N: the left rows' relative
+/// motion per unit force on the right rows): `W_b = C_b G_b,rightᵀ` per body touched, then each
 /// entry the sum over the left row's entries of `W` (both on every core, column by column;
 /// each entry's sum in the order of the row's entries whatever the threads, so the matrix
 /// is the same bitwise on any number of cores).
