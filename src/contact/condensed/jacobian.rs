@@ -1,10 +1,12 @@
 //! The condensed contact problem's Jacobian: one row per active contact, factored once and reused while Newton converges with it.
 
 use crate::contact::condensed::CondensedBody;
+use crate::contact::FrictionKey;
 use crate::Real;
 use faer::linalg::solvers::Solve;
-use faer::{Accum, Mat, MatMut, Par, Side};
+use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
 use std::cell::Cell;
 use std::collections::HashMap;
 
@@ -35,6 +37,9 @@ pub(crate) struct FrictionRow {
     /// While the contact slips, its stiffness `−∂f/∂g` (N/m, Cartesian, unsymmetric);
     /// `None` while it sticks (then `k_n n nᵀ + k_t P`: the rows' penalties, uncoupled).
     pub slipping: Option<Matrix3<Real>>,
+    /// The contact's friction history key: a factor kept across contact sets finds the
+    /// contact's rows by it (see [`ContactJacobian::adopt`]).
+    pub contact: Option<FrictionKey>,
 }
 
 /// `(κ⁻¹ + G C Gᵀ)⁻¹ x`, applied as `(I + κ G C Gᵀ)⁻¹ κ x` (κ may be singular while a
@@ -80,7 +85,10 @@ impl Inverse {
 /// when contacts start or stop slipping only the new rows' columns and the small dense
 /// problem on `S` are formed again, not `F` (see [`ContactJacobian::restiffen`]).
 struct FrictionInverse {
-    llt: faer::linalg::solvers::Llt<Real>,
+    llt: Factor,
+    /// Rows of contacts that left the contact set since the factorization (a factor kept
+    /// across sets): solved as rows of zero stiffness, exactly, through the Schur complement.
+    gone: Vec<bool>,
     /// `R` per row, N/m.
     reference: Vec<Real>,
     /// Whether each row's contact slipped at factorization (never when `exact`).
@@ -95,6 +103,35 @@ struct FrictionInverse {
     schur: Option<faer::linalg::solvers::PartialPivLu<Real>>,
     /// Columns `L⁻¹ e_j` by row `j`, kept with the factor.
     columns: HashMap<usize, Vec<Real>>,
+}
+
+/// The Cholesky factor `F = L Lᵀ` of a [`FrictionInverse`]: faer's as made, or a lower
+/// triangle of its own once rows were bordered in (see [`FrictionInverse::border`]).
+enum Factor {
+    Faer(faer::linalg::solvers::Llt<Real>),
+    Bordered(Mat<Real>),
+}
+
+impl Factor {
+    /// `L` (its lower triangle; the solves read nothing above it).
+    fn l(&self) -> MatRef<'_, Real> {
+        match self {
+            Factor::Faer(llt) => llt.L(),
+            Factor::Bordered(l) => l.as_ref(),
+        }
+    }
+
+    /// `x ← F⁻¹ x`.
+    fn solve_in_place(&self, mut x: MatMut<'_, Real>) {
+        match self {
+            Factor::Faer(llt) => llt.solve_in_place(x),
+            Factor::Bordered(l) => {
+                use faer::linalg::triangular_solve as tri;
+                tri::solve_lower_triangular_in_place(l.as_ref(), x.as_mut(), Par::rayon(0));
+                tri::solve_upper_triangular_in_place(l.transpose(), x, Par::rayon(0));
+            }
+        }
+    }
 }
 
 /// Right-hand sides solved together when columns of `L⁻¹` are formed.
@@ -167,6 +204,19 @@ pub(crate) fn approximate_from() -> usize {
     APPROXIMATE_FROM_HERE.with(Cell::get)
 }
 
+#[cfg(test)]
+thread_local! {
+    /// How often a kept Jacobian took another contact set's rows on this thread (contacts
+    /// bordered in or gone; see [`ContactJacobian::adopt`]).
+    static CARRIED: Cell<usize> = const { Cell::new(0) };
+}
+
+/// How often a kept Jacobian took another contact set on this thread since the last call.
+#[cfg(test)]
+pub(crate) fn take_carried() -> usize {
+    CARRIED.with(|c| c.replace(0))
+}
+
 /// Set this thread's [`approximate_from`] (tests only; the default is [`APPROXIMATE_FROM`]).
 #[cfg(test)]
 pub(crate) fn set_approximate_from(rows: usize) {
@@ -195,7 +245,8 @@ impl FrictionInverse {
             .llt(Side::Lower)
             .map_err(|e| format!("the contact matrix is not positive definite: {e:?}"))?;
         let mut inverse = FrictionInverse {
-            llt,
+            llt: Factor::Faer(llt),
+            gone: vec![false; rows.len()],
             reference: reference_stiffness(rows, exact),
             reference_slips: rows.iter().map(|r| slips(r) && !exact).collect(),
             exact,
@@ -216,7 +267,7 @@ impl FrictionInverse {
         self.slipping = rows
             .iter()
             .enumerate()
-            .filter(|&(i, r)| slips(r) != self.reference_slips[i])
+            .filter(|&(i, r)| self.gone[i] || slips(r) != self.reference_slips[i])
             .map(|(i, _)| i)
             .collect();
         let s = self.slipping.len();
@@ -228,7 +279,8 @@ impl FrictionInverse {
             .slipping
             .iter()
             .map(|&i| {
-                let Some(f) = rows[i].friction else {
+                // A row gone from the contact set has no stiffness: its force is zero.
+                let Some(f) = rows[i].friction.filter(|_| !self.gone[i]) else {
                     return Vec::new();
                 };
                 // A contact's rows change state together, so they are all in `S`.
@@ -244,7 +296,7 @@ impl FrictionInverse {
         }
         // The columns of L⁻¹ not formed yet, in blocks from the first row of each (the
         // forward solve of e_j is zero above j).
-        let l = self.llt.L();
+        let l = self.llt.l();
         let mut missing: Vec<usize> = self
             .slipping
             .iter()
@@ -336,6 +388,134 @@ impl FrictionInverse {
     }
 }
 
+impl FrictionInverse {
+    /// Border `m` new rows into the factor: `a12` (n × m) their coupling `A12` with the
+    /// factor's rows, `a22` (m × m) `A22 + R⁻¹` among themselves (`R` their
+    /// [`reference_stiffness`]), `reference` and `reference_slips` theirs. `F` becomes
+    /// `[F A12; A21 A22 + R⁻¹]` with `L21 = A21 L11⁻ᵀ`, `L22 = chol(A22 + R⁻¹ − L21 L21ᵀ)`
+    /// (`n² m` flops), and the kept columns of `L⁻¹` are extended
+    /// (`[x; −L22⁻¹ L21 x]`). `Err` (nothing changed) if the new block is not positive
+    /// definite.
+    fn border(
+        &mut self,
+        a12: Mat<Real>,
+        mut a22: Mat<Real>,
+        reference: &[Real],
+        reference_slips: &[bool],
+    ) -> Result<(), String> {
+        use faer::linalg::triangular_solve as tri;
+        let n = self.reference.len();
+        let m = a22.nrows();
+        let mut l21t = a12;
+        tri::solve_lower_triangular_in_place(self.llt.l(), l21t.as_mut(), Par::rayon(0));
+        faer::linalg::matmul::matmul(
+            a22.as_mut(),
+            Accum::Add,
+            l21t.transpose(),
+            l21t.as_ref(),
+            -1.0,
+            Par::rayon(0),
+        );
+        let l22 = a22
+            .llt(Side::Lower)
+            .map_err(|e| format!("the bordered contact matrix is not positive definite: {e:?}"))?;
+        let mut l = Mat::<Real>::zeros(n + m, n + m);
+        l.as_mut().submatrix_mut(0, 0, n, n).copy_from(self.llt.l());
+        l.as_mut()
+            .submatrix_mut(n, 0, m, n)
+            .copy_from(l21t.transpose());
+        l.as_mut().submatrix_mut(n, n, m, m).copy_from(l22.L());
+        // The kept columns of L⁻¹: the new rows' part of L⁻¹ e_j is −L22⁻¹ L21 (L11⁻¹ e_j).
+        let kept: Vec<usize> = self.columns.keys().copied().collect();
+        if !kept.is_empty() {
+            let mut x = Mat::<Real>::zeros(n, kept.len());
+            for (q, j) in kept.iter().enumerate() {
+                for (i, &v) in self.columns[j].iter().enumerate() {
+                    x[(i, q)] = v;
+                }
+            }
+            let mut y = Mat::<Real>::zeros(m, kept.len());
+            faer::linalg::matmul::matmul(
+                y.as_mut(),
+                Accum::Replace,
+                l21t.transpose(),
+                x.as_ref(),
+                -1.0,
+                Par::rayon(0),
+            );
+            tri::solve_lower_triangular_in_place(l22.L(), y.as_mut(), Par::rayon(0));
+            for (q, j) in kept.iter().enumerate() {
+                if let Some(column) = self.columns.get_mut(j) {
+                    column.extend((0..m).map(|i| y[(i, q)]));
+                }
+            }
+        }
+        self.llt = Factor::Bordered(l);
+        self.reference.extend_from_slice(reference);
+        self.reference_slips.extend_from_slice(reference_slips);
+        self.gone.extend(std::iter::repeat_n(false, m));
+        Ok(())
+    }
+}
+
+/// `G_left C G_rightᵀ` for two lists of contact rows (m/N: the left rows' relative
+/// motion per unit force on the right rows): `W_b = C_b G_b,rightᵀ` per body touched, then each
+/// entry the sum over the left row's entries of `W` (both on every core, column by column;
+/// each entry's sum in the order of the row's entries whatever the threads, so the matrix
+/// is the same bitwise on any number of cores).
+fn coupling(bodies: &[&CondensedBody], left: &[ContactRow], right: &[ContactRow]) -> Mat<Real> {
+    let k = right.len();
+    // W_b = C_b G_bᵀ, one column per contact (zero where the contact does not touch b).
+    let w: Vec<Option<Mat<Real>>> = bodies
+        .iter()
+        .enumerate()
+        .map(|(b, body)| {
+            if !right.iter().any(|r| r.entries.iter().any(|e| e.0 == b)) {
+                return None;
+            }
+            let mut wb = Mat::<Real>::zeros(body.len(), k);
+            wb.as_mut()
+                .par_col_iter_mut()
+                .zip(right.par_iter())
+                .for_each(|(mut col, row)| {
+                    for &(bb, s, v) in &row.entries {
+                        if bb != b {
+                            continue;
+                        }
+                        let c = body.compliance_column(s);
+                        for (i, &ci) in c.iter().enumerate() {
+                            col[i] += v * ci;
+                        }
+                    }
+                });
+            Some(wb)
+        })
+        .collect();
+    let mut a = Mat::<Real>::zeros(left.len(), k);
+    a.as_mut()
+        .par_col_iter_mut()
+        .enumerate()
+        .for_each(|(e2, mut col)| {
+            let columns: Vec<Option<&[Real]>> = w
+                .iter()
+                .map(|wb| {
+                    wb.as_ref()
+                        .and_then(|m| m.col(e2).try_as_col_major().map(|c| c.as_slice()))
+                })
+                .collect();
+            for (e1, row) in left.iter().enumerate() {
+                let mut sum = 0.0;
+                for &(b, s, v) in &row.entries {
+                    if let Some(c) = columns[b] {
+                        sum += v * c[s];
+                    }
+                }
+                col[e1] += sum;
+            }
+        });
+    a
+}
+
 /// A Newton correction of the condensed contact problem.
 pub(crate) struct Correction {
     /// Change of the contact forces at each body's candidate slots, N.
@@ -384,18 +564,7 @@ impl ContactJacobian {
         exact: bool,
     ) -> Result<Self, String> {
         let k = rows.len();
-        // W_b = C_b G_bᵀ, one column per contact (zero where the contact does not touch b).
-        let mut w: Vec<Option<Mat<Real>>> = bodies.iter().map(|_| None).collect();
-        for (e, row) in rows.iter().enumerate() {
-            for &(b, s, v) in &row.entries {
-                let c = bodies[b].compliance_column(s);
-                let wb = w[b].get_or_insert_with(|| Mat::zeros(bodies[b].len(), k));
-                let mut col = wb.col_mut(e);
-                for (i, &ci) in c.iter().enumerate() {
-                    col[i] += v * ci;
-                }
-            }
-        }
+        let clock = std::time::Instant::now();
         let general = rows.iter().any(|r| r.friction.is_some());
         if general
             && rows
@@ -404,35 +573,18 @@ impl ContactJacobian {
         {
             return Err("a contact row has no positive stiffness".into());
         }
-        // A = κ⁻¹ + G W, column by column (W's columns are contiguous); with friction
-        // `F = R⁻¹ + G W`, the rows' stick stiffnesses.
-        let mut a = Mat::<Real>::zeros(k, k);
+        // A = κ⁻¹ + G W (W = C Gᵀ); with friction `F = R⁻¹ + G W`, the rows' reference
+        // stiffnesses.
         let reference = if general {
             reference_stiffness(&rows, exact)
         } else {
             rows.iter().map(|r| r.penalty).collect()
         };
-        for e2 in 0..k {
-            let columns: Vec<Option<&[Real]>> = w
-                .iter()
-                .map(|wb| {
-                    wb.as_ref()
-                        .and_then(|m| m.col(e2).try_as_col_major().map(|c| c.as_slice()))
-                })
-                .collect();
-            let mut col = a.col_mut(e2);
-            for (e1, row) in rows.iter().enumerate() {
-                let mut sum = 0.0;
-                for &(b, s, v) in &row.entries {
-                    if let Some(c) = columns[b] {
-                        sum += v * c[s];
-                    }
-                }
-                col[e1] += sum;
-            }
-            col[e2] += 1.0 / reference[e2];
+        let mut a = coupling(bodies, &rows, &rows);
+        for (e, r) in reference.iter().enumerate() {
+            a[(e, e)] += 1.0 / r;
         }
-        drop(w);
+        let t_form = clock.elapsed().as_secs_f64();
         // Symmetrize round-off before the factorization.
         for i in 0..k {
             for j in 0..i {
@@ -449,6 +601,7 @@ impl ContactJacobian {
                     .map_err(|e| format!("the contact matrix is not positive definite: {e:?}"))?,
             )
         };
+        let t_factor = clock.elapsed().as_secs_f64();
         let mut first = Vec::with_capacity(bodies.len());
         let mut r = 0;
         for b in bodies {
@@ -465,6 +618,13 @@ impl ContactJacobian {
             stabilisation,
         };
         jacobian.rigid(bodies, r);
+        if crate::contact::condensed::solver::trace() {
+            eprintln!(
+                "friction-trace fresh rows {k} form {t_form:.3} factor {:.3} rigid {:.3}",
+                t_factor - t_form,
+                clock.elapsed().as_secs_f64() - t_factor
+            );
+        }
         Ok(jacobian)
     }
 
@@ -520,6 +680,7 @@ impl ContactJacobian {
                     (Some(a), Some(b)) => {
                         a.first == b.first
                             && a.count == b.count
+                            && a.contact == b.contact
                             && a.slipping.is_some() == b.slipping.is_some()
                     }
                     (None, None) => true,
@@ -540,7 +701,9 @@ impl ContactJacobian {
                 .iter()
                 .zip(rows)
                 .all(|(old, new)| match (&old.friction, &new.friction) {
-                    (Some(a), Some(b)) => a.first == b.first && a.count == b.count,
+                    (Some(a), Some(b)) => {
+                        a.first == b.first && a.count == b.count && a.contact == b.contact
+                    }
                     (None, None) => true,
                     _ => false,
                 });
@@ -572,6 +735,152 @@ impl ContactJacobian {
         }
         let r = self.b_psi.ncols() / 2;
         self.rigid(bodies, r);
+        true
+    }
+
+    /// Take another contact set's `rows` into a kept Jacobian with friction, as
+    /// [`ContactJacobian::restiffen`] does for the same set: the rows of contacts still in
+    /// the set (found by their contact's key) keep their factored `G C Gᵀ` and directions and
+    /// take their new states; contacts that left the set become rows of zero stiffness in the
+    /// exact Schur complement (their force zero, so the kept factor solves exactly as a fresh
+    /// factor of the remaining rows would); contacts new to the set are bordered into the
+    /// Cholesky factor (see [`FrictionInverse::border`]). With `keep_if_same`, nothing is
+    /// formed again when the set and every contact's state are those the Jacobian has.
+    /// `false`, and nothing changed, below [`approximate_from`] rows (the exact path there
+    /// forms a Jacobian per set), without friction or keys, when the factor should change from
+    /// exact to approximate, or when more than one row in [`MOST_CHANGED`] would be new, or in
+    /// the Schur complement (gone, or, with an approximate factor, in another state than at
+    /// factorization): a fresh factor costs less then.
+    pub(crate) fn adopt(
+        &mut self,
+        bodies: &[&CondensedBody],
+        rows: &[ContactRow],
+        keep_if_same: bool,
+    ) -> bool {
+        let clock = std::time::Instant::now();
+        let Inverse::Friction(f) = &self.llt else {
+            return false;
+        };
+        let n = self.rows.len();
+        if rows.len() < approximate_from() || n < approximate_from() {
+            return false;
+        }
+        if f.exact && !few_slip(rows) {
+            return false;
+        }
+        // Each new row by its contact's key and its place among the contact's rows.
+        let mut at: HashMap<(FrictionKey, usize), usize> = HashMap::with_capacity(rows.len());
+        for (i, r) in rows.iter().enumerate() {
+            let Some((fr, key)) = r.friction.and_then(|fr| fr.contact.map(|k| (fr, k))) else {
+                return false;
+            };
+            if at.insert((key, i - fr.first), i).is_some() {
+                return false;
+            }
+        }
+        // The Jacobian's rows matched to the new ones (`None`: the contact left the set).
+        let mut matched: Vec<Option<usize>> = vec![None; n];
+        let mut taken = vec![false; rows.len()];
+        for (j, r) in self.rows.iter().enumerate() {
+            let Some((fr, key)) = r.friction.and_then(|fr| fr.contact.map(|k| (fr, k))) else {
+                return false;
+            };
+            if let Some(&i) = at.get(&(key, j - fr.first)) {
+                if rows[i].friction.is_some_and(|g| g.count == fr.count) {
+                    matched[j] = Some(i);
+                    taken[i] = true;
+                }
+            }
+        }
+        let added: Vec<usize> = (0..rows.len()).filter(|&i| !taken[i]).collect();
+        let gone = matched.iter().filter(|m| m.is_none()).count();
+        let changed = if f.exact {
+            0
+        } else {
+            matched
+                .iter()
+                .enumerate()
+                .filter(|&(j, m)| m.is_some_and(|i| slips(&rows[i]) != f.reference_slips[j]))
+                .count()
+        };
+        if (gone + changed) * MOST_CHANGED > n + added.len() || added.len() * MOST_CHANGED > n {
+            return false;
+        }
+        let same = added.is_empty()
+            && matched.iter().enumerate().all(|(j, m)| match m {
+                Some(i) => !f.gone[j] && slips(&rows[*i]) == slips(&self.rows[j]),
+                None => f.gone[j],
+            });
+        if keep_if_same && same {
+            return true;
+        }
+        // The new contacts' rows, with their positions in the Jacobian's rows.
+        let mut new_rows: Vec<ContactRow> = Vec::with_capacity(added.len());
+        for &i in &added {
+            let r = &rows[i];
+            let mut friction = r.friction;
+            if let Some(fr) = friction.as_mut() {
+                // `added` holds a contact's rows together, in order.
+                fr.first = n + new_rows.len() - (i - fr.first);
+            }
+            new_rows.push(ContactRow {
+                penalty: r.penalty,
+                entries: r.entries.clone(),
+                friction,
+            });
+        }
+        if !new_rows.is_empty() {
+            let m = new_rows.len();
+            let exact = f.exact;
+            let reference = reference_stiffness(&new_rows, exact);
+            let reference_slips: Vec<bool> = new_rows.iter().map(|r| slips(r) && !exact).collect();
+            let mut all = std::mem::take(&mut self.rows);
+            all.extend(new_rows);
+            let a = coupling(bodies, &all, &all[n..]);
+            let a12 = a.as_ref().submatrix(0, 0, n, m).to_owned();
+            let mut a22 = Mat::<Real>::zeros(m, m);
+            for i in 0..m {
+                for j in 0..m {
+                    a22[(i, j)] = 0.5 * (a[(n + i, j)] + a[(n + j, i)]);
+                }
+                a22[(i, i)] += 1.0 / reference[i];
+            }
+            let bordered = match &mut self.llt {
+                Inverse::Friction(f) => f.border(a12, a22, &reference, &reference_slips),
+                Inverse::Symmetric(_) => Err(String::new()),
+            };
+            if bordered.is_err() {
+                all.truncate(n);
+                self.rows = all;
+                return false;
+            }
+            self.rows = all;
+        }
+        for (j, m) in matched.iter().enumerate() {
+            if let (Some(i), Some(a)) = (m, self.rows[j].friction.as_mut()) {
+                a.slipping = rows[*i].friction.and_then(|b| b.slipping);
+            }
+        }
+        if let Inverse::Friction(f) = &mut self.llt {
+            for (j, m) in matched.iter().enumerate() {
+                f.gone[j] = m.is_none();
+            }
+            f.set_stiffness(&self.rows);
+        }
+        let r = self.b_psi.ncols() / 2;
+        self.rigid(bodies, r);
+        #[cfg(test)]
+        if !added.is_empty() || gone > 0 {
+            CARRIED.with(|c| c.set(c.get() + 1));
+        }
+        if crate::contact::condensed::solver::trace() {
+            eprintln!(
+                "friction-trace adopt rows {} added {} gone {gone} changed {changed} in {:.3}",
+                self.rows.len(),
+                added.len(),
+                clock.elapsed().as_secs_f64()
+            );
+        }
         true
     }
 
@@ -693,6 +1002,7 @@ mod tests {
                     count: 3,
                     axis: Vector3::ith(i % 3, 1.0),
                     slipping: slipping[i / 3],
+                    contact: None,
                 }),
             })
             .collect()
@@ -719,6 +1029,197 @@ mod tests {
         }
         let m = DMatrix::<Real>::identity(6, 6) + &kappa * a;
         m.lu().solve(&(&kappa * x)).expect("regular")
+    }
+
+    /// A symmetric positive definite `G C Gᵀ` of `k` rows.
+    fn coupling_of(k: usize) -> DMatrix<Real> {
+        let b = DMatrix::<Real>::from_fn(k, k, |i, j| {
+            ((i * 7 + j * 3) % 5) as Real * 0.1 + if i == j { 0.5 } else { 0.0 }
+        });
+        &b * b.transpose() + DMatrix::<Real>::identity(k, k) * 0.1
+    }
+
+    /// Rows of contacts of three rows each along x, y, z, with stick stiffnesses `r` and each
+    /// contact's slipping block (`None`: sticking), numbered from the contact `from`.
+    fn rows_of(r: &[Real], slipping: &[Option<Matrix3<Real>>], from: usize) -> Vec<ContactRow> {
+        (0..r.len())
+            .map(|i| ContactRow {
+                penalty: r[i],
+                entries: Vec::new(),
+                friction: Some(FrictionRow {
+                    first: 3 * (i / 3),
+                    count: 3,
+                    axis: Vector3::ith(i % 3, 1.0),
+                    slipping: slipping[i / 3],
+                    contact: Some(FrictionKey::Obstacle {
+                        body: 0,
+                        node: from + i / 3,
+                        obstacle: 0,
+                    }),
+                }),
+            })
+            .collect()
+    }
+
+    /// `(I + κ A)⁻¹ κ x` by a dense LU of the whole matrix, κ block-diagonal (a contact's
+    /// block its slipping block, or its stick stiffnesses).
+    fn direct_of(
+        a: &DMatrix<Real>,
+        r: &[Real],
+        slipping: &[Option<Matrix3<Real>>],
+        x: &DVector<Real>,
+    ) -> DVector<Real> {
+        let k = r.len();
+        let mut kappa = DMatrix::<Real>::zeros(k, k);
+        for c in 0..k / 3 {
+            for i in 0..3 {
+                for j in 0..3 {
+                    kappa[(3 * c + i, 3 * c + j)] = match slipping[c] {
+                        Some(k3) => k3[(i, j)],
+                        None if i == j => r[3 * c + i],
+                        None => 0.0,
+                    };
+                }
+            }
+        }
+        let m = DMatrix::<Real>::identity(k, k) + &kappa * a;
+        m.lu().solve(&(&kappa * x)).expect("regular")
+    }
+
+    /// `F = A + R⁻¹` of the rows `from..to` as a faer matrix.
+    fn f_of(a: &DMatrix<Real>, r: &[Real], from: usize, to: usize) -> Mat<Real> {
+        Mat::<Real>::from_fn(to - from, to - from, |i, j| {
+            a[(from + i, from + j)] + if i == j { 1.0 / r[from + i] } else { 0.0 }
+        })
+    }
+
+    /// `y = inverse x` for one right-hand side.
+    fn solve_with(inverse: &FrictionInverse, x: &DVector<Real>) -> DVector<Real> {
+        let mut y = Mat::<Real>::from_fn(x.len(), 1, |i, _| x[i]);
+        inverse.solve_in_place(y.as_mut());
+        DVector::from_fn(x.len(), |i, _| y[(i, 0)])
+    }
+
+    #[test]
+    fn a_bordered_factor_equals_a_fresh_factor_of_all_its_rows() {
+        // Four contacts (12 rows); the factor made for the first two, the last two bordered in.
+        let a = coupling_of(12);
+        let r = [4.0, 2.0, 2.0, 5.0, 3.0, 3.0, 6.0, 2.5, 2.5, 3.0, 1.0, 1.0];
+        let (_, _, slip, _) = two_contacts();
+        let x = DVector::from_fn(12, |i, _| ((i * 5 + 1) % 7) as Real - 3.0);
+        let first: [Option<Matrix3<Real>>; 2] = [Some(slip), None];
+        let mut inverse =
+            FrictionInverse::new(f_of(&a, &r, 0, 6), &rows_of(&r[..6], &first, 0), true)
+                .expect("positive definite");
+        // The first contact slips: its columns of L⁻¹ are kept, and extended by the border.
+        assert_eq!(inverse.columns.len(), 3);
+        let full = f_of(&a, &r, 0, 12);
+        let a12 = full.as_ref().submatrix(0, 6, 6, 6).to_owned();
+        let a22 = full.as_ref().submatrix(6, 6, 6, 6).to_owned();
+        inverse
+            .border(a12, a22, &r[6..], &[false; 6])
+            .expect("positive definite");
+        let fresh = full.llt(Side::Lower).expect("positive definite");
+        let (l, l_fresh) = (inverse.llt.l(), fresh.L());
+        for i in 0..12 {
+            for j in 0..=i {
+                assert!(
+                    (l[(i, j)] - l_fresh[(i, j)]).abs() <= 1e-12 * l_fresh[(i, i)].abs(),
+                    "L[{i}, {j}] {} against {}",
+                    l[(i, j)],
+                    l_fresh[(i, j)]
+                );
+            }
+        }
+        // Solves with the bordered factor equal the whole problem's (the kept columns and new
+        // ones in the Schur complement).
+        for states in [
+            [Some(slip), None, None, None],
+            [Some(slip), None, None, Some(slip)],
+            [None, Some(slip), Some(slip), None],
+        ] {
+            inverse.set_stiffness(&rows_of(&r, &states, 0));
+            let y = solve_with(&inverse, &x);
+            let expected = direct_of(&a, &r, &states, &x);
+            assert!(
+                (&y - &expected).amax() <= 1e-12 * expected.amax(),
+                "{states:?}: {y} against {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn rows_gone_from_the_set_solve_as_a_fresh_factor_of_the_rows_left() {
+        // Four contacts factored; the second leaves the set (and the fourth slips): its rows
+        // have no force, the others' answer is that of a fresh factor of the three left.
+        let a = coupling_of(12);
+        let r = [4.0, 2.0, 2.0, 5.0, 3.0, 3.0, 6.0, 2.5, 2.5, 3.0, 1.0, 1.0];
+        let (_, _, slip, _) = two_contacts();
+        let x = DVector::from_fn(12, |i, _| ((i * 5 + 1) % 7) as Real - 3.0);
+        let sticking = [None; 4];
+        let mut inverse =
+            FrictionInverse::new(f_of(&a, &r, 0, 12), &rows_of(&r, &sticking, 0), true)
+                .expect("positive definite");
+        let states = [None, None, None, Some(slip)];
+        for i in 3..6 {
+            inverse.gone[i] = true;
+        }
+        inverse.set_stiffness(&rows_of(&r, &states, 0));
+        let y = solve_with(&inverse, &x);
+        // The fresh factor of the rows left: contacts 0, 2 and 3.
+        let left: Vec<usize> = (0..3).chain(6..12).collect();
+        let a_left = DMatrix::<Real>::from_fn(9, 9, |i, j| a[(left[i], left[j])]);
+        let r_left: Vec<Real> = left.iter().map(|&i| r[i]).collect();
+        let x_left = DVector::from_fn(9, |i, _| x[left[i]]);
+        let expected = direct_of(&a_left, &r_left, &[None, None, Some(slip)], &x_left);
+        for i in 3..6 {
+            assert!(
+                y[i].abs() <= 1e-12 * expected.amax(),
+                "row {i} of a contact gone: {}",
+                y[i]
+            );
+        }
+        for (q, &i) in left.iter().enumerate() {
+            assert!(
+                (y[i] - expected[q]).abs() <= 1e-12 * expected.amax(),
+                "row {i}: {} against {}",
+                y[i],
+                expected[q]
+            );
+        }
+        // A fifth contact bordered in: removing and adding rows, then solving, equals a fresh
+        // factor of the new set (a gone contact's rows, as a block of zero stiffness, have
+        // no force).
+        let a15 = coupling_of(15);
+        let r15 = [
+            4.0, 2.0, 2.0, 5.0, 3.0, 3.0, 6.0, 2.5, 2.5, 3.0, 1.0, 1.0, 2.0, 1.5, 1.5,
+        ];
+        let mut inverse =
+            FrictionInverse::new(f_of(&a15, &r15, 0, 12), &rows_of(&r, &sticking, 0), true)
+                .expect("positive definite");
+        for i in 3..6 {
+            inverse.gone[i] = true;
+        }
+        let full = f_of(&a15, &r15, 0, 15);
+        let a12 = full.as_ref().submatrix(0, 12, 12, 3).to_owned();
+        let a22 = full.as_ref().submatrix(12, 12, 3, 3).to_owned();
+        inverse
+            .border(a12, a22, &r15[12..], &[false; 3])
+            .expect("positive definite");
+        let states15 = [None, None, None, Some(slip), Some(slip)];
+        inverse.set_stiffness(&rows_of(&r15, &states15, 0));
+        let x15 = DVector::from_fn(15, |i, _| ((i * 5 + 1) % 7) as Real - 3.0);
+        let y = solve_with(&inverse, &x15);
+        let gone = [None, Some(Matrix3::zeros()), None, Some(slip), Some(slip)];
+        let expected = direct_of(&a15, &r15, &gone, &x15);
+        for i in 0..15 {
+            assert!(
+                (y[i] - expected[i]).abs() <= 1e-12 * expected.amax(),
+                "row {i}: {} against {}",
+                y[i],
+                expected[i]
+            );
+        }
     }
 
     #[test]

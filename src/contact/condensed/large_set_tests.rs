@@ -1,6 +1,6 @@
 //! The large-set mode of the condensed friction Newton (approximate factor, slip-following rows, Anderson mixing, early letting go), driven through the solver on a small sheared pair by lowering this thread's threshold.
 
-use crate::contact::condensed::jacobian::set_approximate_from;
+use crate::contact::condensed::jacobian::{set_approximate_from, take_carried};
 use crate::contact::condensed::solver::{take_record, Recorded};
 use crate::scene::{build_world, Simulation, StepResult, StepSummary};
 use std::path::Path;
@@ -69,14 +69,27 @@ fn run(from: usize) -> (Vec<(StepResult, StepSummary)>, Vec<Recorded>) {
 
 #[test]
 fn the_large_set_mode_converges_to_the_exact_paths_answer_on_the_sheared_pair() {
+    take_carried();
     let (exact, exact_record) = run(super::jacobian::APPROXIMATE_FROM);
     assert!(
         exact_record.iter().all(|r| !r.approximate),
         "below the threshold every Jacobian is exact"
     );
+    assert_eq!(
+        take_carried(),
+        0,
+        "below the threshold a Jacobian is never kept across contact sets"
+    );
     // From one row: every Jacobian with more than a quarter of its rows slipping is the
-    // approximate factor.
+    // approximate factor, and Jacobians are kept across contact sets (the rows of contacts
+    // that come bordered in, those of contacts that go through the Schur complement).
     let (large, record) = run(1);
+    let carried = take_carried();
+    println!("contact sets taken into a kept Jacobian: {carried}");
+    assert!(
+        carried > 0,
+        "the contact set never changed on a kept Jacobian"
+    );
     let approximate: Vec<&Recorded> = record.iter().filter(|r| r.approximate).collect();
     assert!(
         approximate.len() >= 5,

@@ -410,6 +410,7 @@ impl CondensedSolver {
                 Some(_) if self.follow_slip => slip_axes(&n, &tangential.force, dims),
                 _ => contact_axes(&n, dims),
             };
+            let (key, _) = friction_key(&e.contact);
             let first = rows.len();
             let mut added = Vec::with_capacity(axes.len());
             for axis in &axes {
@@ -431,6 +432,7 @@ impl CondensedSolver {
                         count: axes.len(),
                         axis: *axis,
                         slipping,
+                        contact: Some(key),
                     }),
                 });
             }
@@ -606,10 +608,12 @@ impl CondensedSolver {
         normals: &mut HashMap<ActiveContact, Vector3<Real>>,
         times: &mut PhaseTimes,
     ) -> Result<Option<(usize, bool)>, ContactError> {
+        // A large set's Jacobian with friction is kept across contact sets too: the rows of
+        // contacts that come or go are taken into its factor (see `ContactJacobian::adopt`).
         let mut jacobian = self
             .jacobian
             .take()
-            .filter(|(s, _)| s == p.set)
+            .filter(|(s, j)| s == p.set || carries(j))
             .map(|(_, j)| j);
         let result = self.newton_with(p, parts, normals, times, &mut jacobian);
         self.jacobian = jacobian.map(|j| (p.set.clone(), j));
@@ -807,9 +811,10 @@ impl CondensedSolver {
                 // While Newton converges fast and no contact starts or stops slipping, the
                 // slipping contacts' stiffnesses are kept too (their Schur complement costs
                 // the cube of their rows).
-                reuse = slow < FRICTION_SLOW_ITERATIONS
+                reuse = slow < slow_limit(j)
                     && ((fast && j.same_states(&residual.rows))
-                        || j.restiffen(&views, &residual.rows));
+                        || j.restiffen(&views, &residual.rows)
+                        || j.adopt(&views, &residual.rows, fast));
             }
             let fresh_factor = !reuse;
             if !reuse {
@@ -960,6 +965,12 @@ impl CondensedSolver {
     }
 }
 
+/// Whether a Jacobian is kept for another contact set: with friction, from
+/// [`approximate_from`] rows (below, the exact path forms one per set, as it always has).
+fn carries(j: &ContactJacobian) -> bool {
+    j.has_friction() && j.rows().len() >= approximate_from()
+}
+
 /// Tolerances below which a large set's held contacts beyond μ f_N are let go (see the
 /// Newton loop), before convergence.
 const LOOSE_RELEASE: Real = 1e4;
@@ -1013,7 +1024,7 @@ pub(crate) fn take_record() -> Vec<Recorded> {
 }
 
 /// Whether `LINKAGE_TRACE_FRICTION` is set: each condensed Newton iteration is printed.
-fn trace() -> bool {
+pub(crate) fn trace() -> bool {
     static TRACE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
     *TRACE.get_or_init(|| std::env::var_os("LINKAGE_TRACE_FRICTION").is_some())
 }
@@ -1064,6 +1075,21 @@ fn reversals(h: &Holding, at: &[FrictionState], trial: &[FrictionState]) -> Vec<
 /// Slow iterations (a residual not below a tenth of the one before) a Jacobian with friction
 /// is kept for, its contacts' stiffnesses brought up to date, before it is formed again.
 const FRICTION_SLOW_ITERATIONS: usize = 3;
+
+/// Slow iterations a kept approximate factor (large sets) is kept for: it is kept across
+/// contact sets too, and its iterations (20-50 ms at full size) cost a twentieth of a fresh
+/// factor, so it is given more of them. Measured on `bench_contact --friction` (full size, load
+/// 5-6): 3, 6 and 10 made 10, 7 and 5 fresh factors in steps 1-4, 35.9, 27.5 and 28.2 s.
+const FRICTION_SLOW_APPROXIMATE: usize = 10;
+
+/// How many slow iterations the kept Jacobian `j` is kept for.
+fn slow_limit(j: &ContactJacobian) -> usize {
+    if j.is_approximate() {
+        FRICTION_SLOW_APPROXIMATE
+    } else {
+        FRICTION_SLOW_ITERATIONS
+    }
+}
 
 /// A friction Newton that seems to stall above this many tolerances with a kept Jacobian is
 /// given a fresh one first (the 20,000-node pair's floor is about 10 tolerances).
