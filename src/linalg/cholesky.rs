@@ -436,7 +436,9 @@ impl SparseCholesky {
         };
         let multi = matches!(par, Par::Rayon(t) if t.get() > 1);
         let len = arrays.val_ptr.last().copied().unwrap_or(0);
-        let ((l_values, solver), tree) = rayon::join(
+        // The factor's first touch (split among the threads) beside the tree plan and the
+        // solver's other arrays.
+        let ((l_values, solver), (tree, (pattern, a_diag, l_diag))) = rayon::join(
             || {
                 (
                     zeroed(early, len),
@@ -444,11 +446,20 @@ impl SparseCholesky {
                 )
             },
             || {
-                if multi {
+                let tree = if multi {
                     TreePlan::new(arrays.clone(), col_ptr, row_idx, &inv)
                 } else {
                     None
-                }
+                };
+                let pattern = SymbolicSparseColMat::new_checked(
+                    n,
+                    n,
+                    col_ptr.to_vec(),
+                    None,
+                    row_idx.to_vec(),
+                );
+                let a_diag: Vec<usize> = perm.iter().map(|&old| col_ptr[old]).collect();
+                (tree, (pattern, a_diag, arrays.diagonal_positions()))
             },
         );
         let (Some(tree), Some(solver)) = (tree, solver) else {
@@ -466,10 +477,6 @@ impl SparseCholesky {
             );
         };
         let l_values = l_values?;
-        let pattern =
-            SymbolicSparseColMat::new_checked(n, n, col_ptr.to_vec(), None, row_idx.to_vec());
-        let a_diag: Vec<usize> = perm.iter().map(|&old| col_ptr[old]).collect();
-        let l_diag = arrays.diagonal_positions();
         Ok(Self {
             n,
             pattern,

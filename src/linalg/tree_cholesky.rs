@@ -30,6 +30,10 @@ pub(crate) const MIN_TREE_WORK: f64 = 2e8;
 /// Narrowest column block of a supernode whose updates are shared between threads.
 const MIN_BLOCK_COLUMNS: usize = 16;
 
+/// Fewest rows of a row block of the solve below a supernode's diagonal block, when that
+/// solve is split into rayon tasks.
+const MIN_BLOCK_ROWS: usize = 64;
+
 /// Fewest columns of an update product whose square part is formed as a lower triangle only
 /// (below it the full square costs less than the triangular product's blocking).
 const MIN_TRIANGULAR_PRODUCT: usize = 16;
@@ -378,6 +382,7 @@ impl TreePlan {
         }
         let mut next = scatter_ptr.clone();
         let mut scatter_src = vec![0usize; row_idx.len()];
+        // Each entry's factor row first, replaced by its place below.
         let mut scatter_dst = vec![0usize; row_idx.len()];
         for j in 0..n {
             for (p, &i) in row_idx
@@ -388,16 +393,33 @@ impl TreePlan {
             {
                 let (a, b) = (inv[i], inv[j]);
                 let (r, c) = if a >= b { (a, b) } else { (b, a) };
-                let k = super_of[c];
-                let w = begin[k + 1] - begin[k];
-                let local = if r < begin[k + 1] {
-                    r - begin[k]
-                } else {
-                    w + pat(k).binary_search(&r).ok()?
-                };
                 scatter_src[next[c]] = p;
-                scatter_dst[next[c]] = col_start[c] + local;
+                scatter_dst[next[c]] = r;
                 next[c] += 1;
+            }
+        }
+        // Supernode by supernode, a row below the diagonal block is found through a map of
+        // the supernode's rows (`owner` marks which supernode set it) instead of a search.
+        let mut owner = vec![usize::MAX; n];
+        let mut place = vec![0usize; n];
+        for k in 0..ns {
+            let (b, e) = (begin[k], begin[k + 1]);
+            for (i, &r) in pat(k).iter().enumerate() {
+                owner[r] = k;
+                place[r] = e - b + i;
+            }
+            for c in b..e {
+                for dst in &mut scatter_dst[scatter_ptr[c]..scatter_ptr[c + 1]] {
+                    let r = *dst;
+                    let local = if r < e {
+                        r - b
+                    } else if owner[r] == k {
+                        place[r]
+                    } else {
+                        return None;
+                    };
+                    *dst = col_start[c] + local;
+                }
             }
         }
         let max_width = (0..ns).map(|k| begin[k + 1] - begin[k]).max().unwrap_or(0);
@@ -471,13 +493,13 @@ impl TreePlan {
         if threads > 1 && parts.len() > 1 {
             let errors: Vec<Result<(), usize>> = parts
                 .into_par_iter()
-                .map(|(r, part)| self.subtree(r, part, &mut self.scratch(), par, true))
+                .map(|(r, part)| self.subtree(r, part, &mut self.scratch(), par, threads))
                 .collect();
             errors.into_iter().min_by_key(|e| e.err()).unwrap_or(Ok(()))
         } else {
             let mut scratch = self.scratch();
             for (r, part) in parts {
-                self.subtree(r, part, &mut scratch, par, threads > 1)?;
+                self.subtree(r, part, &mut scratch, par, threads)?;
             }
             Ok(())
         }
@@ -521,15 +543,17 @@ impl TreePlan {
     }
 
     /// Factors the subtree of `k`, whose values are `l` (from its first supernode on).
-    /// `split`: subtrees may be handed to other threads.
+    /// `tasks`: the threads of the pool; above 1, subtrees may be handed to other threads,
+    /// and the chains above their forks split their work into tasks.
     fn subtree(
         &self,
         k: usize,
         l: &mut [f64],
         scratch: &mut Scratch,
         par: Par,
-        split: bool,
+        tasks: usize,
     ) -> Result<(), usize> {
+        let split = tasks > 1;
         let base = self.val_ptr[self.first[k]];
         if split && self.work[k] > self.split_work {
             // A separator split into several supernodes is a chain of single children
@@ -554,15 +578,18 @@ impl TreePlan {
                     .into_par_iter()
                     .map(|(c, part)| {
                         let mut own = self.scratch();
-                        self.subtree(c, part, &mut own, Par::Seq, true)
+                        self.subtree(c, part, &mut own, Par::Seq, tasks)
                     })
                     .collect();
                 if let Some(e) = results.into_iter().filter_map(Result::err).min() {
                     return Err(e);
                 }
-                // The chain from the fork up to `k`, each with the shared kernels.
+                // The chain from the fork up to `k`, each with the shared kernels (at the top)
+                // or sequential kernels in tasks that an idle thread can take: below the top,
+                // the two halves' chains differ in work (the root separator is merged with
+                // one of them), and the thread done first would otherwise wait.
                 for s in fork..=k {
-                    self.supernode(s, l, base, scratch, par)?;
+                    self.supernode(s, l, base, scratch, par, tasks)?;
                 }
                 return Ok(());
             }
@@ -571,7 +598,7 @@ impl TreePlan {
         for s in self.first[k]..=k {
             // Only the separators at the top of an unsplit tree are big enough to share.
             let p = if s == k { par } else { kernels };
-            self.supernode(s, l, base, scratch, p)?;
+            self.supernode(s, l, base, scratch, p, 1)?;
         }
         Ok(())
     }
@@ -579,10 +606,12 @@ impl TreePlan {
     /// Updates supernode `k` by its descendants, factors its diagonal block and solves for
     /// its rows below. `l` holds the values from offset `base` up to and including `k`'s.
     ///
-    /// With several threads (`par`) and a wide supernode, the descendants' updates are
-    /// applied to column blocks of `k` side by side, each block by one thread with
-    /// sequential products: the updates of a separator come from hundreds of small
-    /// descendants, and sharing each small product between threads cost a barrier each.
+    /// With several threads (`par`, or `tasks` for rayon tasks with sequential kernels) and
+    /// a wide supernode, the descendants' updates are applied to column blocks of `k` side
+    /// by side, each block by one thread with sequential products: the updates of a
+    /// separator come from hundreds of small descendants, and sharing each small product
+    /// between threads cost a barrier each. With sequential kernels and several `tasks`,
+    /// the solve for the rows below is split into row blocks likewise.
     fn supernode(
         &self,
         k: usize,
@@ -590,6 +619,7 @@ impl TreePlan {
         base: usize,
         scratch: &mut Scratch,
         par: Par,
+        tasks: usize,
     ) -> Result<(), usize> {
         let (sb, se) = (self.begin[k], self.begin[k + 1]);
         let w = se - sb;
@@ -603,8 +633,8 @@ impl TreePlan {
         let head = &*head;
         let updaters = &self.updaters[self.updaters_ptr[k]..self.updaters_ptr[k + 1]];
         let threads = match par {
-            Par::Seq => 1,
-            Par::Rayon(t) => t.get(),
+            Par::Seq => tasks,
+            Par::Rayon(t) => t.get().max(tasks),
         };
         let blocks = (4 * threads).min(w / MIN_BLOCK_COLUMNS);
         if threads > 1 && blocks > 1 && !updaters.is_empty() {
@@ -660,7 +690,25 @@ impl TreePlan {
             Ok(_) => {}
             Err(LltError::NonPositivePivot { index }) => return Err(sb + index),
         }
-        solve_lower_triangular_in_place(top.rb(), bot.transpose_mut(), par);
+        let row_blocks = (4 * tasks).min(pat.len() / MIN_BLOCK_ROWS);
+        if matches!(par, Par::Seq) && row_blocks > 1 {
+            // Each row of the block below is solved on its own: row blocks side by side,
+            // split at fixed places (the same bits whichever thread takes a block).
+            let mut parts = Vec::with_capacity(row_blocks);
+            let mut rest = bot;
+            for b in 0..row_blocks {
+                let len = rest.nrows() / (row_blocks - b);
+                let (part, tail) = rest.split_at_row_mut(len);
+                parts.push(part);
+                rest = tail;
+            }
+            let top = top.rb();
+            parts.into_par_iter().for_each(|part| {
+                solve_lower_triangular_in_place(top, part.transpose_mut(), Par::Seq);
+            });
+        } else {
+            solve_lower_triangular_in_place(top.rb(), bot.transpose_mut(), par);
+        }
         Ok(())
     }
 
