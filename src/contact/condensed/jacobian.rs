@@ -103,6 +103,9 @@ struct FrictionInverse {
     schur: Option<faer::linalg::solvers::PartialPivLu<Real>>,
     /// Columns `L⁻¹ e_j` by row `j`, kept with the factor.
     columns: HashMap<usize, Vec<Real>>,
+    /// `Z = Xᵀ X` on `slipping` as last formed (`None` when none is, or the factor changed
+    /// since): the same rows in `S` take it again, only `K` and the small LU are new.
+    z: Option<Mat<Real>>,
 }
 
 /// The Cholesky factor `F = L Lᵀ` of a [`FrictionInverse`]: faer's as made, or a lower
@@ -254,6 +257,7 @@ impl FrictionInverse {
             kappa: Vec::new(),
             schur: None,
             columns: HashMap::new(),
+            z: None,
         };
         inverse.set_stiffness(rows);
         Ok(inverse)
@@ -262,21 +266,24 @@ impl FrictionInverse {
     /// Take the blocks of the contacts of `rows` whose state differs from the one at
     /// factorization (turned into the rows' own axes) and form the Schur complement on their
     /// rows.
-    fn set_stiffness(&mut self, rows: &[ContactRow]) {
+    ///
+    /// Returns whether the inverse changed: `false` when the rows in `S` and their `K` are
+    /// those it already has (a Jacobian taking the same states again at a later iterate),
+    /// so that nothing is formed again, not even what depends on the inverse.
+    fn set_stiffness(&mut self, rows: &[ContactRow]) -> bool {
         let k = rows.len();
-        self.slipping = rows
+        let slipping: Vec<usize> = rows
             .iter()
             .enumerate()
             .filter(|&(i, r)| self.gone[i] || slips(r) != self.reference_slips[i])
             .map(|(i, _)| i)
             .collect();
-        let s = self.slipping.len();
+        let s = slipping.len();
         let mut position = vec![usize::MAX; k];
-        for (p, &i) in self.slipping.iter().enumerate() {
+        for (p, &i) in slipping.iter().enumerate() {
             position[i] = p;
         }
-        self.kappa = self
-            .slipping
+        let kappa: Vec<Vec<(usize, Real)>> = slipping
             .iter()
             .map(|&i| {
                 // A row gone from the contact set has no stiffness: its force is zero.
@@ -290,10 +297,42 @@ impl FrictionInverse {
                     .collect()
             })
             .collect();
+        // `Z` depends only on the factor and on which rows are in `S`; the Schur complement
+        // on `K` too: the same rows and `K` give the same inverse, bit for bit.
+        let same_rows = self.z.is_some() && slipping == self.slipping;
+        if same_rows && kappa == self.kappa {
+            return false;
+        }
+        self.slipping = slipping;
+        self.kappa = kappa;
         if s == 0 {
             self.schur = None;
-            return;
+            self.z = Some(Mat::zeros(0, 0));
+            return true;
         }
+        let z = match self.z.take().filter(|_| same_rows) {
+            Some(z) => z,
+            None => self.form_z(k),
+        };
+        // (I − K R⁻¹) Z + K, K block-diagonal.
+        let mut schur = z.clone();
+        for (p, row) in self.kappa.iter().enumerate() {
+            for &(q, v) in row {
+                let c = v / self.reference[self.slipping[q]];
+                for j in 0..s {
+                    schur[(p, j)] -= c * z[(q, j)];
+                }
+                schur[(p, q)] += v;
+            }
+        }
+        self.schur = Some(schur.partial_piv_lu());
+        self.z = Some(z);
+        true
+    }
+
+    /// `Z = Xᵀ X` on the rows in `slipping`, `X = L⁻¹ E_S` (the columns not kept yet formed).
+    fn form_z(&mut self, k: usize) -> Mat<Real> {
+        let s = self.slipping.len();
         // The columns of L⁻¹ not formed yet, in blocks from the first row of each (the
         // forward solve of e_j is zero above j).
         let l = self.llt.l();
@@ -340,21 +379,74 @@ impl FrictionInverse {
             1.0,
             Par::rayon(0),
         );
-        // (I − K R⁻¹) Z + K, K block-diagonal.
-        let mut schur = z.clone();
-        for (p, row) in self.kappa.iter().enumerate() {
-            for &(q, v) in row {
-                let c = v / self.reference[self.slipping[q]];
-                for j in 0..s {
-                    schur[(p, j)] -= c * z[(q, j)];
-                }
-                schur[(p, q)] += v;
-            }
-        }
-        self.schur = Some(schur.partial_piv_lu());
+        z
     }
 
     fn solve_in_place(&self, mut x: MatMut<'_, Real>) {
+        if self.reference.len() >= approximate_from() && self.solve_split(x.as_mut()) {
+            return;
+        }
+        self.solve_twice(x);
+    }
+
+    /// The solve of [`FrictionInverse`] with one forward and one backward solve by `L` (the
+    /// large-set mode's; [`FrictionInverse::solve_twice`]'s arithmetic below it):
+    /// `v = L⁻¹ [x_T; 0]`, `y⁰_S = Xᵀ v`, then `y = L⁻ᵀ (v + X w_S)`, as
+    /// `F⁻¹ E_S = L⁻ᵀ X`. `false`, and `x` untouched, when there is no Schur complement or
+    /// a column of `X` is missing.
+    fn solve_split(&self, mut x: MatMut<'_, Real>) -> bool {
+        use faer::linalg::triangular_solve as tri;
+        let Some(schur) = &self.schur else {
+            return false;
+        };
+        let columns: Option<Vec<&Vec<Real>>> =
+            self.slipping.iter().map(|j| self.columns.get(j)).collect();
+        let Some(columns) = columns else {
+            return false;
+        };
+        let l = self.llt.l();
+        let mut v = x.to_owned();
+        for &j in &self.slipping {
+            for c in 0..v.ncols() {
+                v[(j, c)] = 0.0;
+            }
+        }
+        tri::solve_lower_triangular_in_place(l, v.as_mut(), Par::rayon(0));
+        let s = self.slipping.len();
+        let mut y0 = Mat::<Real>::zeros(s, x.ncols());
+        for (p, column) in columns.iter().enumerate() {
+            for c in 0..x.ncols() {
+                y0[(p, c)] = column.iter().enumerate().map(|(i, a)| a * v[(i, c)]).sum();
+            }
+        }
+        // K x_S − (I − K R⁻¹) y⁰_S.
+        let mut r = Mat::<Real>::zeros(s, x.ncols());
+        for (p, row) in self.kappa.iter().enumerate() {
+            for c in 0..x.ncols() {
+                let mut value = -y0[(p, c)];
+                for &(q, kv) in row {
+                    let j = self.slipping[q];
+                    value += kv * (x[(j, c)] + y0[(q, c)] / self.reference[j]);
+                }
+                r[(p, c)] = value;
+            }
+        }
+        schur.solve_in_place(r.as_mut());
+        for (p, column) in columns.iter().enumerate() {
+            for c in 0..x.ncols() {
+                let w = r[(p, c)];
+                for (i, a) in column.iter().enumerate() {
+                    v[(i, c)] += a * w;
+                }
+            }
+        }
+        tri::solve_upper_triangular_in_place(l.transpose(), v.as_mut(), Par::rayon(0));
+        x.copy_from(&v);
+        true
+    }
+
+    /// The solve with two solves by `F` (`y⁰`, then `y = F⁻¹ w`).
+    fn solve_twice(&self, mut x: MatMut<'_, Real>) {
         let mut y0 = x.to_owned();
         for &j in &self.slipping {
             for c in 0..y0.ncols() {
@@ -451,6 +543,8 @@ impl FrictionInverse {
             }
         }
         self.llt = Factor::Bordered(l);
+        // `Z` was of the factor before: every entry now has the new rows' part too.
+        self.z = None;
         self.reference.extend_from_slice(reference);
         self.reference_slips.extend_from_slice(reference_slips);
         self.gone.extend(std::iter::repeat_n(false, m));
@@ -730,11 +824,15 @@ impl ContactJacobian {
                 a.slipping = b.slipping;
             }
         }
-        if let Inverse::Friction(f) = &mut self.llt {
-            f.set_stiffness(&self.rows);
+        let changed = match &mut self.llt {
+            Inverse::Friction(f) => f.set_stiffness(&self.rows),
+            Inverse::Symmetric(_) => true,
+        };
+        // The rigid motions' terms depend on the rows' directions and the inverse only.
+        if changed {
+            let r = self.b_psi.ncols() / 2;
+            self.rigid(bodies, r);
         }
-        let r = self.b_psi.ncols() / 2;
-        self.rigid(bodies, r);
         true
     }
 
@@ -829,7 +927,8 @@ impl ContactJacobian {
                 friction,
             });
         }
-        if !new_rows.is_empty() {
+        let new_rows_empty = new_rows.is_empty();
+        if !new_rows_empty {
             let m = new_rows.len();
             let exact = f.exact;
             let reference = reference_stiffness(&new_rows, exact);
@@ -861,14 +960,21 @@ impl ContactJacobian {
                 a.slipping = rows[*i].friction.and_then(|b| b.slipping);
             }
         }
-        if let Inverse::Friction(f) = &mut self.llt {
-            for (j, m) in matched.iter().enumerate() {
-                f.gone[j] = m.is_none();
+        let changed = match &mut self.llt {
+            Inverse::Friction(f) => {
+                for (j, m) in matched.iter().enumerate() {
+                    f.gone[j] = m.is_none();
+                }
+                f.set_stiffness(&self.rows)
             }
-            f.set_stiffness(&self.rows);
+            Inverse::Symmetric(_) => true,
+        };
+        // New rows change `B` and the factor (and `set_stiffness` reports it); else the
+        // rigid motions' terms depend on the inverse only.
+        if changed || !new_rows_empty {
+            let r = self.b_psi.ncols() / 2;
+            self.rigid(bodies, r);
         }
-        let r = self.b_psi.ncols() / 2;
-        self.rigid(bodies, r);
         #[cfg(test)]
         if !added.is_empty() || gone > 0 {
             CARRIED.with(|c| c.set(c.get() + 1));
@@ -898,7 +1004,12 @@ impl ContactJacobian {
     ) -> Correction {
         let k = self.rows.len();
         let r = self.eigen.as_ref().map_or(0, |e| e.eigenvalues.len());
-        let cphi: Vec<Vec<Real>> = bodies.iter().zip(phi1).map(|(b, p)| b.comply(p)).collect();
+        // The bodies' compliance products side by side (each reads a dense compliance).
+        let cphi: Vec<Vec<Real>> = bodies
+            .par_iter()
+            .zip(phi1)
+            .map(|(b, p)| b.comply(p))
+            .collect();
         // μ₀ = A⁻¹ G C Φ₁.
         let mut mu = Mat::<Real>::zeros(k, 1);
         for (e, row) in self.rows.iter().enumerate() {
@@ -1263,6 +1374,42 @@ mod tests {
             (&y - &exact).amax() <= 1e-8 * exact.amax(),
             "{y} against {exact}"
         );
+    }
+
+    #[test]
+    fn the_split_solve_equals_the_solve_by_two_factor_solves() {
+        // The factor made with the second contact slipping, then the first slips and the
+        // second sticks (both in the Schur complement): one forward and one backward solve
+        // by `L` with `X`'s columns give what two solves by `F` give.
+        let (a, r, slip, x) = two_contacts();
+        let at_factor = rows(&r, [None, Some(slip)]);
+        let reference = reference_stiffness(&at_factor, false);
+        let f = Mat::<Real>::from_fn(6, 6, |i, j| {
+            a[(i, j)] + if i == j { 1.0 / reference[i] } else { 0.0 }
+        });
+        let mut inverse = FrictionInverse::new(f, &at_factor, false).expect("positive definite");
+        inverse.set_stiffness(&rows(&r, [Some(slip), None]));
+        let rhs = Mat::<Real>::from_fn(6, 2, |i, c| x[i] * (1.0 + c as Real) - c as Real);
+        let mut twice = rhs.clone();
+        inverse.solve_twice(twice.as_mut());
+        let mut split = rhs.clone();
+        assert!(inverse.solve_split(split.as_mut()));
+        let largest = twice.norm_max();
+        for i in 0..6 {
+            for c in 0..2 {
+                assert!(
+                    (split[(i, c)] - twice[(i, c)]).abs() <= 1e-12 * largest,
+                    "row {i} column {c}: {} against {}",
+                    split[(i, c)],
+                    twice[(i, c)]
+                );
+            }
+        }
+        // And the exact answer, the dense solve of the unsymmetric Jacobian.
+        let exact = direct(&a, &r, [Some(slip), None], &x);
+        for i in 0..6 {
+            assert!((split[(i, 0)] - exact[i]).abs() <= 1e-8 * exact.amax());
+        }
     }
 
     #[test]
