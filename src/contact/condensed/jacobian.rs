@@ -1101,45 +1101,19 @@ mod tests {
         )
     }
 
-    /// Rows of two contacts of three rows each along x, y, z, with stick stiffnesses `r`
-    /// and each contact's slipping block (`None`: sticking).
+    /// Rows of two contacts of three rows each (see [`rows_of`]).
     fn rows(r: &[Real; 6], slipping: [Option<Matrix3<Real>>; 2]) -> Vec<ContactRow> {
-        (0..6)
-            .map(|i| ContactRow {
-                penalty: r[i],
-                entries: Vec::new(),
-                friction: Some(FrictionRow {
-                    first: 3 * (i / 3),
-                    count: 3,
-                    axis: Vector3::ith(i % 3, 1.0),
-                    slipping: slipping[i / 3],
-                    contact: None,
-                }),
-            })
-            .collect()
+        rows_of(r, &slipping, 0)
     }
 
-    /// `(I + κ A)⁻¹ κ x` by a dense LU of the whole matrix, κ block-diagonal.
+    /// `(I + κ A)⁻¹ κ x` for two contacts (see [`direct_of`]).
     fn direct(
         a: &DMatrix<Real>,
         r: &[Real; 6],
         slipping: [Option<Matrix3<Real>>; 2],
         x: &DVector<Real>,
     ) -> DVector<Real> {
-        let mut kappa = DMatrix::<Real>::zeros(6, 6);
-        for c in 0..2 {
-            for i in 0..3 {
-                for j in 0..3 {
-                    kappa[(3 * c + i, 3 * c + j)] = match slipping[c] {
-                        Some(k3) => k3[(i, j)],
-                        None if i == j => r[3 * c + i],
-                        None => 0.0,
-                    };
-                }
-            }
-        }
-        let m = DMatrix::<Real>::identity(6, 6) + &kappa * a;
-        m.lu().solve(&(&kappa * x)).expect("regular")
+        direct_of(a, r, &slipping, x)
     }
 
     /// A symmetric positive definite `G C Gᵀ` of `k` rows.
