@@ -517,39 +517,7 @@ fn a_block_on_a_slope_holds_while_tan_theta_is_below_mu_and_slides_above() {
 /// normal totals (1e-6).
 #[test]
 fn a_sheared_pair_converges_whole_steps_on_the_condensed_path_to_the_exact_law() {
-    let scene = r#"
-name = "sheared_pair"
-steps = 3
-[[materials]]
-name = "rubber"
-youngs_modulus = 1e7
-area = 1e-4
-[[bodies]]
-name = "lower"
-box_lattice = { size = [0.2, 0.1, 0.2], cells = [4, 4, 4] }
-[[bodies.supports]]
-on_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
-fix = ["x", "y", "z"]
-[[bodies]]
-name = "upper"
-box_lattice = { size = [0.2, 0.1, 0.2], cells = [4, 4, 4] }
-offset = [0.0, 0.1, 0.0]
-[[bodies.supports]]
-on_line = { point = [0.0, 0.1, 0.0], direction = [0.0, 1.0, 0.0] }
-fix = ["x", "z"]
-displacement = [1e-4, 0.0, 0.0]
-schedule = [0.0, 1.0, 2.0]
-[[bodies.supports]]
-on_line = { point = [0.2, 0.1, 0.2], direction = [0.0, 1.0, 0.0] }
-fix = ["x", "z"]
-displacement = [1e-4, 0.0, 0.0]
-schedule = [0.0, 1.0, 2.0]
-[[bodies.loads]]
-on_plane = { point = [0.0, 0.2, 0.0], normal = [0.0, 1.0, 0.0] }
-total_force = [0.0, -500.0, 0.0]
-[contact]
-friction = 0.3
-"#;
+    let scene = include_str!("common/sheared_pair.toml");
     let mut world =
         linkage::scene::build_world(scene, Path::new("sheared_pair.toml")).expect("a valid scene");
     let mut sim = Simulation::new(&world).expect("builds");

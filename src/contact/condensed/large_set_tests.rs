@@ -5,52 +5,24 @@ use crate::contact::condensed::solver::{take_record, Recorded};
 use crate::scene::{build_world, Simulation, StepResult, StepSummary};
 use std::path::Path;
 
-/// The sheared pair of `tests/friction.rs` with 8 cells per edge instead of 4 (μ = 0.3,
+/// The sheared pair of `tests/friction.rs` (`tests/common/sheared_pair.toml`) with 8 cells per edge instead of 4 (μ = 0.3,
 /// 500 N pressing, the upper box sheared 0.1 mm per step from step 2; 135-158 contacts). With
 /// 4 cells the large-set mode does not converge on the condensed path (step 1 leaves it, the
 /// approximate factor's corrections cycling between residuals of about 0.56 and 0.89, the
 /// same with mixing and early letting-go switched off): the approximate factor is made for
 /// fine interfaces (it is used from 2,000 rows), not for coarse ones.
-const SHEARED_PAIR: &str = r#"
-name = "sheared_pair"
-steps = 3
-[[materials]]
-name = "rubber"
-youngs_modulus = 1e7
-area = 1e-4
-[[bodies]]
-name = "lower"
-box_lattice = { size = [0.2, 0.1, 0.2], cells = [8, 8, 8] }
-[[bodies.supports]]
-on_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
-fix = ["x", "y", "z"]
-[[bodies]]
-name = "upper"
-box_lattice = { size = [0.2, 0.1, 0.2], cells = [8, 8, 8] }
-offset = [0.0, 0.1, 0.0]
-[[bodies.supports]]
-on_line = { point = [0.0, 0.1, 0.0], direction = [0.0, 1.0, 0.0] }
-fix = ["x", "z"]
-displacement = [1e-4, 0.0, 0.0]
-schedule = [0.0, 1.0, 2.0]
-[[bodies.supports]]
-on_line = { point = [0.2, 0.1, 0.2], direction = [0.0, 1.0, 0.0] }
-fix = ["x", "z"]
-displacement = [1e-4, 0.0, 0.0]
-schedule = [0.0, 1.0, 2.0]
-[[bodies.loads]]
-on_plane = { point = [0.0, 0.2, 0.0], normal = [0.0, 1.0, 0.0] }
-total_force = [0.0, -500.0, 0.0]
-[contact]
-friction = 0.3
-"#;
+fn sheared_pair() -> String {
+    include_str!("../../../tests/common/sheared_pair.toml")
+        .replace("cells = [4, 4, 4]", "cells = [8, 8, 8]")
+}
 
 /// Every step of the sheared pair with the large-set mode from `from` rows on this thread,
 /// and the condensed Newton's iterations recorded meanwhile.
 fn run(from: usize) -> (Vec<(StepResult, StepSummary)>, Vec<Recorded>) {
     set_approximate_from(from);
     take_record();
-    let world = build_world(SHEARED_PAIR, Path::new("sheared_pair.toml")).expect("a valid scene");
+    let world =
+        build_world(&sheared_pair(), Path::new("sheared_pair.toml")).expect("a valid scene");
     let mut sim = Simulation::new(&world).expect("builds");
     let mut steps = Vec::new();
     for k in 0..=world.steps {
