@@ -5,9 +5,10 @@ use crate::contact::evaluate::Evaluation;
 use crate::contact::settle::{BodyPart, Problem};
 use crate::contact::{ContactError, NodeContact, SlipState, Target};
 use crate::linkage::body_state::{internal_force_vector, member_response_at, norm};
-use crate::linkage::{post_process, StepState};
+use crate::linkage::{post_process, Body, StepState};
 use crate::Real;
 use nalgebra::Vector3;
+use rayon::prelude::*;
 
 /// A solved step of a scene with contact.
 #[derive(Clone, Debug, Default)]
@@ -129,71 +130,97 @@ pub(crate) fn finish(
             }
         }
     }
-    for ((b, body), fc) in bodies.iter().enumerate().zip(all) {
-        let part = &parts[b];
-        let d = part.dofs.dofs_per_node;
-        let mut internal = internal_force_vector(body, &part.u);
-        for (i, f) in internal.iter_mut().zip(&fc) {
-            *i -= f;
-        }
-        let members = (0..body.members.len()).map(|m| {
-            let r = member_response_at(body, &part.u, m);
-            (r.strain, r.force)
-        });
-        let mut state = post_process(body, &part.dofs, &part.u, &forces[b], &internal, members);
-        state.iterations = out.newton_iterations;
-        // Relative to the largest of applied, reaction and contact forces (a body held by
-        // contact alone has no reactions), and at least the force floor.
-        let out_of_balance = part
-            .dofs
-            .free
-            .iter()
-            .map(|&dof| (internal[dof] - forces[b][dof]).powi(2))
-            .sum::<Real>()
-            .sqrt();
-        let reacted = part
-            .dofs
-            .supported
-            .iter()
-            .map(|&dof| (internal[dof] - forces[b][dof]).powi(2))
-            .sum::<Real>()
-            .sqrt();
-        let scale = norm(&forces[b])
-            .max(reacted)
-            .max(norm(&fc))
-            .max(p.force_floor);
-        state.residual = if scale > 0.0 {
-            out_of_balance / scale
-        } else {
-            out_of_balance
-        };
-        if !state.residual.is_finite()
-            || state
-                .displacements
-                .iter()
-                .any(|u| !u.iter().all(|c| c.is_finite()))
-        {
-            return Err(ContactError::NotFinite { step });
-        }
-        let mut contacts = std::mem::take(&mut touched[b]);
-        for c in &mut contacts {
-            for k in d..3 {
-                c.force[k] = 0.0;
-                c.normal[k] = 0.0;
-                c.tangential_force[k] = 0.0;
-                c.slip[k] = 0.0;
-            }
-            c.normal_force = c.normal.norm();
-            if c.normal_force > 0.0 {
-                c.normal /= c.normal_force;
-            }
-        }
-        contacts.sort_by(|a, b| a.node.cmp(&b.node).then(a.with.cmp(&b.with)));
-        out.totals.push(totals(&contacts));
+    // The bodies side by side (each body's arithmetic is the same as alone); the first body
+    // in order that fails decides, as one at a time did.
+    let iterations = out.newton_iterations;
+    let each: Vec<Result<BodyReport, ContactError>> = bodies
+        .par_iter()
+        .zip(all)
+        .zip(touched)
+        .enumerate()
+        .map(|(b, ((body, fc), contacts))| {
+            body_report(p, &parts[b], body, &forces[b], fc, contacts, iterations)
+        })
+        .collect();
+    for report in each {
+        let (totals, state, contacts) = report?;
+        out.totals.push(totals);
         out.states.push(state);
         out.contacts.push(contacts);
     }
     Ok(out)
+}
+
+/// One body's part of the report: its totals per pair, its state and its contacts.
+type BodyReport = (Vec<(String, Vector3<Real>)>, StepState, Vec<NodeContact>);
+
+/// The report of one body (`part` of `body`, applied `forces`, contact forces `fc` per DOF,
+/// the nodes it touches with) after `iterations` Newton iterations.
+fn body_report(
+    p: &Problem,
+    part: &BodyPart,
+    body: &Body,
+    forces: &[Real],
+    fc: Vec<Real>,
+    mut contacts: Vec<NodeContact>,
+    iterations: usize,
+) -> Result<BodyReport, ContactError> {
+    let step = p.step;
+    let d = part.dofs.dofs_per_node;
+    let mut internal = internal_force_vector(body, &part.u);
+    for (i, f) in internal.iter_mut().zip(&fc) {
+        *i -= f;
+    }
+    let members = (0..body.members.len()).map(|m| {
+        let r = member_response_at(body, &part.u, m);
+        (r.strain, r.force)
+    });
+    let mut state = post_process(body, &part.dofs, &part.u, forces, &internal, members);
+    state.iterations = iterations;
+    // Relative to the largest of applied, reaction and contact forces (a body held by
+    // contact alone has no reactions), and at least the force floor.
+    let out_of_balance = part
+        .dofs
+        .free
+        .iter()
+        .map(|&dof| (internal[dof] - forces[dof]).powi(2))
+        .sum::<Real>()
+        .sqrt();
+    let reacted = part
+        .dofs
+        .supported
+        .iter()
+        .map(|&dof| (internal[dof] - forces[dof]).powi(2))
+        .sum::<Real>()
+        .sqrt();
+    let scale = norm(forces).max(reacted).max(norm(&fc)).max(p.force_floor);
+    state.residual = if scale > 0.0 {
+        out_of_balance / scale
+    } else {
+        out_of_balance
+    };
+    if !state.residual.is_finite()
+        || state
+            .displacements
+            .iter()
+            .any(|u| !u.iter().all(|c| c.is_finite()))
+    {
+        return Err(ContactError::NotFinite { step });
+    }
+    for c in &mut contacts {
+        for k in d..3 {
+            c.force[k] = 0.0;
+            c.normal[k] = 0.0;
+            c.tangential_force[k] = 0.0;
+            c.slip[k] = 0.0;
+        }
+        c.normal_force = c.normal.norm();
+        if c.normal_force > 0.0 {
+            c.normal /= c.normal_force;
+        }
+    }
+    contacts.sort_by(|a, b| a.node.cmp(&b.node).then(a.with.cmp(&b.with)));
+    Ok((totals(&contacts), state, contacts))
 }
 
 /// The total force of `contacts` per body or obstacle touched, N, in name order.

@@ -13,7 +13,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
-use rayon::iter::ParallelExtend;
+use rayon::iter::{IndexedParallelIterator, ParallelExtend, ParallelIterator};
 use std::sync::atomic::{AtomicBool, Ordering as AtomicOrdering};
 
 use super::node_symbolic::{node_symbolic, NodeSymbolic};
@@ -834,23 +834,28 @@ impl SparseCholesky {
         let mut block = faer::Mat::<f64>::zeros(m, m);
         // Supernode k: a column-major block of (width + pattern) rows × width columns from
         // val_ptr[k], its square diagonal block on top (faer's storage and the node path's).
-        for k in arrays.super_of.get(first).copied().unwrap_or(arrays.len())..arrays.len() {
-            let (start, end) = (arrays.begin[k], arrays.begin[k + 1]);
-            let width = end - start;
-            let pattern = arrays.pattern(k);
-            let rows = width + pattern.len();
-            let base = arrays.val_ptr[k];
-            for col in start.max(first)..end {
+        // The columns side by side (the block is as large as the compliance).
+        block
+            .as_mut()
+            .par_col_iter_mut()
+            .enumerate()
+            .for_each(|(j, mut column)| {
+                let col = first + j;
+                let k = arrays.super_of[col];
+                let (start, end) = (arrays.begin[k], arrays.begin[k + 1]);
+                let width = end - start;
+                let pattern = arrays.pattern(k);
+                let rows = width + pattern.len();
                 let c = col - start;
-                let values = &self.l_values[base + c * rows..base + (c + 1) * rows];
+                let base = arrays.val_ptr[k] + c * rows;
+                let values = &self.l_values[base..base + rows];
                 for (r, &v) in values.iter().enumerate().take(width).skip(c) {
-                    block[(start + r - first, col - first)] = v;
+                    column[start + r - first] = v;
                 }
                 for (&row, &v) in pattern.iter().zip(&values[width..]) {
-                    block[(row - first, col - first)] = v;
+                    column[row - first] = v;
                 }
-            }
-        }
+            });
         Some((self.perm[first..].to_vec(), block))
     }
 
@@ -1460,6 +1465,33 @@ pub(crate) mod tests {
             factor_entries(&x, &a, &perm, &inv, &sizes),
             chol.stats().nnz_l
         );
+    }
+
+    /// A solve of a zero right-hand side gives positive zeros, in faer's loop and on the tree
+    /// path: the condensed bodies' expansion skips that solve when nothing changed
+    /// (`CondensedSolver::expand`), which must give the same bits.
+    #[test]
+    fn a_zero_right_hand_side_solves_to_positive_zeros() {
+        // 16×16×25 cells: 21,675 DOFs, above MIN_TREE_DOFS.
+        let (s, _) = crate::bench::cholmod::lattice_system([16, 16, 25]).unwrap();
+        let options = CholeskyOptions {
+            threads: 2,
+            ..Default::default()
+        };
+        for tree in [true, false] {
+            let analyze = if tree {
+                SparseCholesky::analyze_with
+            } else {
+                SparseCholesky::analyze_with_faers_loop
+            };
+            let mut chol =
+                analyze(s.n, &s.col_ptr, &s.row_idx, s.groups.as_deref(), options).unwrap();
+            assert_eq!(chol.is_tree_parallel(), tree);
+            chol.factorize(&s.values).unwrap();
+            let mut x = vec![0.0; s.n];
+            chol.solve_in_place(&mut x);
+            assert!(x.iter().all(|v| v.to_bits() == 0), "tree = {tree}");
+        }
     }
 
     /// On the tree path the analysis keeps the cheaper of METIS's default ordering and

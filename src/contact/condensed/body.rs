@@ -10,6 +10,7 @@ use crate::linkage::{
 };
 use crate::Real;
 use faer::Mat;
+use rayon::prelude::*;
 
 /// A free DOF that is not a contact candidate.
 pub(crate) const NOT_CANDIDATE: usize = usize::MAX;
@@ -217,12 +218,15 @@ impl CondensedBody {
             for b in 0..basis.len() {
                 let h: Real = basis[a].iter().zip(&z[b]).map(|(x, y)| x * y).sum();
                 let (za, qa, zb, qb) = (&zc[a], &qc[a], &zc[b], &qc[b]);
-                for j in 0..m {
-                    let column = &mut compliance[j * m..(j + 1) * m];
-                    for (i, c) in column.iter_mut().enumerate() {
-                        *c += -za[i] * qb[j] - qa[i] * zb[j] + qa[i] * h * qb[j];
-                    }
-                }
+                // Columns side by side: the last body to finish its set-up runs this alone.
+                compliance
+                    .par_chunks_mut(m.max(1))
+                    .enumerate()
+                    .for_each(|(j, column)| {
+                        for (i, c) in column.iter_mut().enumerate() {
+                            *c += -za[i] * qb[j] - qa[i] * zb[j] + qa[i] * h * qb[j];
+                        }
+                    });
             }
         }
         let relief = t.elapsed().as_secs_f64();
@@ -407,13 +411,17 @@ fn inverse_from_factor(l: &Mat<Real>) -> Vec<Real> {
         par,
         faer::dyn_stack::MemStack::new(&mut mem),
     );
+    // Column j of the full matrix: row j of the lower triangle above the diagonal, then
+    // column j of it; the columns side by side.
     let mut full = vec![0.0; m * m];
-    for j in 0..m {
-        for i in j..m {
-            let v = out[(i, j)];
-            full[j * m + i] = v;
-            full[i * m + j] = v;
+    let lower = out.as_ref();
+    full.par_chunks_mut(m).enumerate().for_each(|(j, column)| {
+        for (i, c) in column.iter_mut().enumerate().take(j) {
+            *c = lower[(j, i)];
         }
-    }
+        for (i, c) in column.iter_mut().enumerate().skip(j) {
+            *c = lower[(i, j)];
+        }
+    });
     full
 }
