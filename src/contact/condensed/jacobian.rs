@@ -552,62 +552,288 @@ impl FrictionInverse {
     }
 }
 
-/// `G_left C G_rightᵀ` for two lists of contact rows (m/N: the left rows' relative
-/// motion per unit force on the right rows): `W_b = C_b G_b,rightᵀ` per body touched, then each
-/// entry the sum over the left row's entries of `W` (both on every core, column by column;
-/// each entry's sum in the order of the row's entries whatever the threads, so the matrix
-/// is the same bitwise on any number of cores).
-fn coupling(bodies: &[&CondensedBody], left: &[ContactRow], right: &[ContactRow]) -> Mat<Real> {
-    let k = right.len();
-    // W_b = C_b G_bᵀ, one column per contact (zero where the contact does not touch b).
-    let w: Vec<Option<Mat<Real>>> = bodies
-        .iter()
-        .enumerate()
-        .map(|(b, body)| {
-            if !right.iter().any(|r| r.entries.iter().any(|e| e.0 == b)) {
+/// A row's nonzero entries, as (body, candidate slot, coefficient).
+type Entries = Vec<(usize, usize, Real)>;
+
+/// Contact rows as Cartesian node rows: a contact with friction in 3D (three rows, the
+/// normal and two tangents) has the same node entries in each row, the weight `w` of an
+/// entry at a node's DOF `k` times the row's axis component `axis[k]`. Its `G C Gᵀ` blocks
+/// are then `axesᵀ (G̃ C G̃ᵀ) axes`, with `G̃` three Cartesian rows (x, y, z) of the weights
+/// alone, each with a third of the entries: the sums over entries pairs cost 3× fewer
+/// multiply-adds and reads of `C`. Any other row (frictionless, 2D, a contact whose rows do
+/// not have this form) is its own Cartesian row, its projection the identity.
+struct Cartesian {
+    /// The Cartesian rows (a contact's x, y, z; or a row of its own).
+    rows: Vec<Entries>,
+    /// Each group of rows in order: its first contact row and first Cartesian row, and the
+    /// contact's axes (as rows; `None`: one row of its own).
+    groups: Vec<(usize, usize, Option<Matrix3<Real>>)>,
+}
+
+/// How far an entry of a contact's row may be from its weight times the row's axis
+/// component, relative to the weight, for the contact to be taken as Cartesian rows: the
+/// round-off of forming the entries and of recovering the weight (`Σ_r v_r axis_r`), with
+/// orthonormal axes.
+const CARTESIAN_TOLERANCE: Real = 1e-14;
+
+impl Cartesian {
+    fn new(rows: &[ContactRow]) -> Self {
+        let mut out = Cartesian {
+            rows: Vec::with_capacity(rows.len()),
+            groups: Vec::with_capacity(rows.len()),
+        };
+        let mut i = 0;
+        while i < rows.len() {
+            if let Some((axes, xyz)) = Self::contact(&rows[i..]) {
+                out.groups.push((i, out.rows.len(), Some(axes)));
+                out.rows.extend(xyz);
+                i += 3;
+            } else {
+                out.groups.push((i, out.rows.len(), None));
+                out.rows.push(rows[i].entries.clone());
+                i += 1;
+            }
+        }
+        out
+    }
+
+    /// The Cartesian rows of the contact whose rows start `rows`, and its axes (as rows of a
+    /// matrix), when its three rows have the form `w axis[k]` on the same entries.
+    fn contact(rows: &[ContactRow]) -> Option<(Matrix3<Real>, [Entries; 3])> {
+        let [r0, r1, r2] = rows.get(..3)? else {
+            return None;
+        };
+        let f = r0.friction?;
+        let same = |r: &ContactRow| {
+            r.friction
+                .is_some_and(|g| g.first == f.first && g.count == 3 && g.contact == f.contact)
+                && r.entries.len() == r0.entries.len()
+                && r.entries
+                    .iter()
+                    .zip(&r0.entries)
+                    .all(|(a, b)| a.0 == b.0 && a.1 == b.1)
+        };
+        if f.count != 3 || !same(r1) || !same(r2) {
+            return None;
+        }
+        let axes = [f.axis, r1.friction?.axis, r2.friction?.axis];
+        let mut xyz: [Entries; 3] = Default::default();
+        for (j, &(b, s, _)) in r0.entries.iter().enumerate() {
+            let v = [r0.entries[j].2, r1.entries[j].2, r2.entries[j].2];
+            // The entry's Cartesian direction: `Σ_r v_r axis_r = w e_k` for orthonormal axes.
+            let u = axes[0] * v[0] + axes[1] * v[1] + axes[2] * v[2];
+            let k = u.iamax();
+            let w = u[k];
+            if w == 0.0 {
+                if v.iter().all(|&x| x == 0.0) {
+                    continue;
+                }
                 return None;
             }
-            let mut wb = Mat::<Real>::zeros(body.len(), k);
-            wb.as_mut()
-                .par_col_iter_mut()
-                .zip(right.par_iter())
-                .for_each(|(mut col, row)| {
-                    for &(bb, s, v) in &row.entries {
-                        if bb != b {
-                            continue;
+            if (0..3).any(|r| (v[r] - w * axes[r][k]).abs() > CARTESIAN_TOLERANCE * w.abs()) {
+                return None;
+            }
+            xyz[k].push((b, s, w));
+        }
+        Some((
+            Matrix3::from_rows(&[
+                axes[0].transpose(),
+                axes[1].transpose(),
+                axes[2].transpose(),
+            ]),
+            xyz,
+        ))
+    }
+}
+
+/// Which part of `G C Gᵀ` [`coupling`] forms.
+#[derive(Clone, Copy, PartialEq)]
+enum Part {
+    /// Every entry.
+    Whole,
+    /// The rows' own (left and right the same rows) lower triangle, the diagonal blocks of the
+    /// contacts whole, zero above them: all that a Cholesky factor of the lower side reads.
+    Lower,
+}
+
+/// `G_left C G_rightᵀ` for two lists of contact rows (m/N: the left rows' relative
+/// motion per unit force on the right rows), or with [`Part::Lower`] the lower triangle of
+/// `G C Gᵀ` for `left` (= `right`), through their Cartesian rows (see [`Cartesian`]): per
+/// right group (on every core), its columns `W_b = C_b G̃_bᵀ` per body touched (a thread's
+/// buffer, kept in cache for what follows), then per left group the Cartesian block (each
+/// entry the sum over the left Cartesian row's entries of `W`) projected on the two groups'
+/// axes. Each entry's sums go in a fixed order whatever the threads, so the matrix is the
+/// same bitwise on any number of cores.
+fn coupling(
+    bodies: &[&CondensedBody],
+    left: &[ContactRow],
+    right: &[ContactRow],
+    part: Part,
+) -> Mat<Real> {
+    let (l, r) = (Cartesian::new(left), Cartesian::new(right));
+    let mut a = Mat::<Real>::zeros(left.len(), right.len());
+    // The columns of `a` of each right group.
+    let mut blocks = Vec::with_capacity(r.groups.len());
+    let mut rest = a.as_mut();
+    for &(_, _, axes) in &r.groups {
+        let (block, tail) = rest.split_at_col_mut(if axes.is_some() { 3 } else { 1 });
+        blocks.push(block);
+        rest = tail;
+    }
+    let sizes: Vec<usize> = bodies.iter().map(|b| b.len()).collect();
+    blocks
+        .into_par_iter()
+        .zip(r.groups.par_iter())
+        .for_each_init(
+            || vec![Vec::<Real>::new(); 3 * bodies.len()],
+            |buffers, (mut block, &(rr, rq, raxes))| {
+                let width = block.ncols();
+                // W's columns of the group per body (`None`: the row does not touch the body).
+                let mut touched_any = vec![false; 3 * bodies.len()];
+                for q in 0..width {
+                    for (b, &m) in sizes.iter().enumerate() {
+                        let column = &mut buffers[q * bodies.len() + b];
+                        let mut any = false;
+                        for &(bb, s, v) in &r.rows[rq + q] {
+                            if bb != b {
+                                continue;
+                            }
+                            if !any {
+                                column.clear();
+                                column.resize(m, 0.0);
+                                any = true;
+                            }
+                            let c = bodies[b].compliance_column(s);
+                            for (x, &ci) in column.iter_mut().zip(c) {
+                                *x += v * ci;
+                            }
                         }
-                        let c = body.compliance_column(s);
-                        for (i, &ci) in c.iter().enumerate() {
-                            col[i] += v * ci;
-                        }
-                    }
-                });
-            Some(wb)
-        })
-        .collect();
-    let mut a = Mat::<Real>::zeros(left.len(), k);
-    a.as_mut()
-        .par_col_iter_mut()
-        .enumerate()
-        .for_each(|(e2, mut col)| {
-            let columns: Vec<Option<&[Real]>> = w
-                .iter()
-                .map(|wb| {
-                    wb.as_ref()
-                        .and_then(|m| m.col(e2).try_as_col_major().map(|c| c.as_slice()))
-                })
-                .collect();
-            for (e1, row) in left.iter().enumerate() {
-                let mut sum = 0.0;
-                for &(b, s, v) in &row.entries {
-                    if let Some(c) = columns[b] {
-                        sum += v * c[s];
+                        touched_any[q * bodies.len() + b] = any;
                     }
                 }
-                col[e1] += sum;
-            }
-        });
+                for &(lr, lq, laxes) in &l.groups {
+                    if part == Part::Lower && lr < rr {
+                        continue;
+                    }
+                    let height = if laxes.is_some() { 3 } else { 1 };
+                    let mut m = Matrix3::<Real>::zeros();
+                    for p in 0..height {
+                        for q in 0..width {
+                            let mut sum = 0.0;
+                            for &(b, s, v) in &l.rows[lq + p] {
+                                let i = q * bodies.len() + b;
+                                if touched_any[i] {
+                                    sum += v * buffers[i][s];
+                                }
+                            }
+                            m[(p, q)] = sum;
+                        }
+                    }
+                    // axes_l G̃ C G̃ᵀ axes_rᵀ (an identity for a row of its own).
+                    let m = match laxes {
+                        Some(al) => al * m,
+                        None => m,
+                    };
+                    let m = match raxes {
+                        Some(ar) => m * ar.transpose(),
+                        None => m,
+                    };
+                    for p in 0..height {
+                        for q in 0..width {
+                            block[(lr + p, q)] = m[(p, q)];
+                        }
+                    }
+                }
+            },
+        );
+    #[cfg(test)]
+    check_coupling(bodies, left, right, part, &a, &l);
     a
+}
+
+#[cfg(test)]
+thread_local! {
+    /// While `Some`: each [`coupling`] on this thread is checked against
+    /// [`coupling_by_rows`], recording the largest difference of an entry relative to
+    /// `sqrt(A_ii A_jj)` (its bound for a symmetric positive semidefinite `G C Gᵀ`), the
+    /// contacts taken as Cartesian rows, those of them touching two bodies, and the calls
+    /// forming the whole matrix (a kept Jacobian's border).
+    static COUPLING_CHECK: Cell<Option<(Real, usize, usize, usize)>> = const { Cell::new(None) };
+}
+
+/// Start (`true`) or stop checking [`coupling`] on this thread; returns what was recorded
+/// since the start (largest relative difference, Cartesian contacts, of them touching two
+/// bodies, whole-matrix calls).
+#[cfg(test)]
+pub(crate) fn check_couplings(on: bool) -> Option<(Real, usize, usize, usize)> {
+    COUPLING_CHECK.with(|c| c.replace(on.then_some((0.0, 0, 0, 0))))
+}
+
+/// `G_left C G_rightᵀ` row by row, entry by entry (the reference of [`coupling`]).
+#[cfg(test)]
+fn coupling_by_rows(
+    bodies: &[&CondensedBody],
+    left: &[ContactRow],
+    right: &[ContactRow],
+) -> Mat<Real> {
+    let entry = |a: &ContactRow, b: &ContactRow| {
+        let mut sum = 0.0;
+        for &(b1, s1, v1) in &a.entries {
+            for &(b2, s2, v2) in &b.entries {
+                if b1 == b2 {
+                    sum += v1 * v2 * bodies[b1].compliance_column(s2)[s1];
+                }
+            }
+        }
+        sum
+    };
+    Mat::from_fn(left.len(), right.len(), |i, j| entry(&left[i], &right[j]))
+}
+
+/// Record how far `a` (of [`coupling`]) is from [`coupling_by_rows`] when checking.
+#[cfg(test)]
+fn check_coupling(
+    bodies: &[&CondensedBody],
+    left: &[ContactRow],
+    right: &[ContactRow],
+    part: Part,
+    a: &Mat<Real>,
+    l: &Cartesian,
+) {
+    let Some((mut worst, mut cartesian, mut two, mut whole)) = COUPLING_CHECK.with(Cell::get)
+    else {
+        return;
+    };
+    let reference = coupling_by_rows(bodies, left, right);
+    let own = |rows: &[ContactRow]| -> Vec<Real> {
+        rows.iter()
+            .map(|r| {
+                coupling_by_rows(bodies, std::slice::from_ref(r), std::slice::from_ref(r))[(0, 0)]
+            })
+            .collect()
+    };
+    let (dl, dr) = (own(left), own(right));
+    for j in 0..right.len() {
+        for i in 0..left.len() {
+            // `Part::Lower` forms the lower triangle (and the contacts' diagonal blocks).
+            if part == Part::Lower && i < j {
+                continue;
+            }
+            let scale = (dl[i] * dr[j]).sqrt();
+            worst = worst.max((a[(i, j)] - reference[(i, j)]).abs() / scale);
+        }
+    }
+    for &(row, _, axes) in &l.groups {
+        if axes.is_some() {
+            cartesian += 1;
+            let b0 = left[row].entries.first().map(|e| e.0);
+            if left[row].entries.iter().any(|e| Some(e.0) != b0) {
+                two += 1;
+            }
+        }
+    }
+    whole += usize::from(part == Part::Whole);
+    COUPLING_CHECK.with(|c| c.set(Some((worst, cartesian, two, whole))));
 }
 
 /// A Newton correction of the condensed contact problem.
@@ -667,26 +893,19 @@ impl ContactJacobian {
         {
             return Err("a contact row has no positive stiffness".into());
         }
-        // A = κ⁻¹ + G W (W = C Gᵀ); with friction `F = R⁻¹ + G W`, the rows' reference
+        // A = κ⁻¹ + G C Gᵀ; with friction `F = R⁻¹ + G C Gᵀ`, the rows' reference
         // stiffnesses.
         let reference = if general {
             reference_stiffness(&rows, exact)
         } else {
             rows.iter().map(|r| r.penalty).collect()
         };
-        let mut a = coupling(bodies, &rows, &rows);
+        let mut a = coupling(bodies, &rows, &rows, Part::Lower);
         for (e, r) in reference.iter().enumerate() {
             a[(e, e)] += 1.0 / r;
         }
         let t_form = clock.elapsed().as_secs_f64();
-        // Symmetrize round-off before the factorization.
-        for i in 0..k {
-            for j in 0..i {
-                let v = 0.5 * (a[(i, j)] + a[(j, i)]);
-                a[(i, j)] = v;
-                a[(j, i)] = v;
-            }
-        }
+        // Only the lower triangle is formed: the factorizations below read nothing else.
         let llt = if general {
             Inverse::Friction(Box::new(FrictionInverse::new(a, &rows, exact)?))
         } else {
@@ -935,7 +1154,7 @@ impl ContactJacobian {
             let reference_slips: Vec<bool> = new_rows.iter().map(|r| slips(r) && !exact).collect();
             let mut all = std::mem::take(&mut self.rows);
             all.extend(new_rows);
-            let a = coupling(bodies, &all, &all[n..]);
+            let a = coupling(bodies, &all, &all[n..], Part::Whole);
             let a12 = a.as_ref().submatrix(0, 0, n, m).to_owned();
             let mut a22 = Mat::<Real>::zeros(m, m);
             for i in 0..m {

@@ -1,6 +1,6 @@
 //! The large-set mode of the condensed friction Newton (approximate factor, slip-following rows, Anderson mixing, early letting go), driven through the solver on a small sheared pair by lowering this thread's threshold.
 
-use crate::contact::condensed::jacobian::{set_approximate_from, take_carried};
+use crate::contact::condensed::jacobian::{check_couplings, set_approximate_from, take_carried};
 use crate::contact::condensed::solver::{take_record, Recorded};
 use crate::scene::{build_world, Simulation, StepResult, StepSummary};
 use std::path::Path;
@@ -136,4 +136,28 @@ fn the_large_set_mode_converges_to_the_exact_paths_answer_on_the_sheared_pair() 
     println!(
         "largest difference of a contact force from the exact path's: {largest:.1e} of the load"
     );
+}
+
+#[test]
+fn g_c_gt_from_cartesian_node_blocks_equals_the_row_by_row_one_on_the_sheared_pair() {
+    // Every `G C Gᵀ` of the sheared pair, formed from the contacts' Cartesian blocks, against
+    // the sums row by row: the fresh factors of the exact path (the lower triangle), then
+    // with the large-set mode from one row, the borders of kept Jacobians (whole blocks).
+    for from in [super::jacobian::APPROXIMATE_FROM, 1] {
+        check_couplings(true);
+        run(from);
+        let (worst, cartesian, two, whole) = check_couplings(false).expect("checked");
+        println!(
+            "from {from} rows: largest relative difference {worst:.1e}; {cartesian} contacts \
+             as Cartesian rows, {two} of them touching two bodies; {whole} borders"
+        );
+        assert!(worst <= 1e-13, "from {from} rows: {worst:.1e}");
+        assert!(
+            cartesian > 0 && two > 0,
+            "from {from} rows: no Cartesian contact"
+        );
+        if from == 1 {
+            assert!(whole > 0, "no border was formed");
+        }
+    }
 }
