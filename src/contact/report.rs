@@ -179,20 +179,14 @@ fn body_report(
     state.iterations = iterations;
     // Relative to the largest of applied, reaction and contact forces (a body held by
     // contact alone has no reactions), and at least the force floor.
-    let out_of_balance = part
-        .dofs
-        .free
-        .iter()
-        .map(|&dof| (internal[dof] - forces[dof]).powi(2))
-        .sum::<Real>()
-        .sqrt();
-    let reacted = part
-        .dofs
-        .supported
-        .iter()
-        .map(|&dof| (internal[dof] - forces[dof]).powi(2))
-        .sum::<Real>()
-        .sqrt();
+    let unbalanced = |dofs: &[usize]| -> Real {
+        dofs.iter()
+            .map(|&dof| (internal[dof] - forces[dof]).powi(2))
+            .sum::<Real>()
+            .sqrt()
+    };
+    let out_of_balance = unbalanced(&part.dofs.free);
+    let reacted = unbalanced(&part.dofs.supported);
     let scale = norm(forces).max(reacted).max(norm(&fc)).max(p.force_floor);
     state.residual = if scale > 0.0 {
         out_of_balance / scale
