@@ -1469,7 +1469,7 @@ pub(crate) mod tests {
 
     /// A solve of a zero right-hand side gives positive zeros, in faer's loop and on the tree
     /// path: the condensed bodies' expansion skips that solve when nothing changed
-    /// (`CondensedSolver::expand`), which must give the same bits.
+    /// (`CondensedBody::expand`), which must give the same bits.
     #[test]
     fn a_zero_right_hand_side_solves_to_positive_zeros() {
         // 16×16×25 cells: 21,675 DOFs, above MIN_TREE_DOFS.

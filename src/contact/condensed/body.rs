@@ -346,7 +346,12 @@ impl CondensedBody {
     /// contact forces per free DOF (N) and `alpha` of the rigid amplitudes: `K⁻¹ rhs + R α`
     /// (one solve). Solving for changes keeps the solve's round-off relative to the change,
     /// as Newton's corrections do, not to the whole displacement.
+    /// No change (the first step from rest) gives zeros without a solve: the exact zeros a
+    /// solve of a zero load gives.
     pub fn expand(&mut self, rhs: &[Real], alpha: &[Real]) -> Vec<Real> {
+        if rhs.iter().chain(alpha).all(|&v| v == 0.0) {
+            return vec![0.0; rhs.len()];
+        }
         let mut x = self.solve(rhs);
         for (r, &a) in self.modes.iter().zip(alpha) {
             x.iter_mut().zip(r).for_each(|(u, m)| *u += a * m);

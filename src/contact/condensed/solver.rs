@@ -303,13 +303,7 @@ impl CondensedSolver {
                     .zip(&c.alpha_expanded)
                     .map(|(a, b)| a - b)
                     .collect();
-                // Nothing changed since the last solve (the first step from rest): its solve
-                // would give zeros (the exact zeros every solve of a zero load gives).
-                let du = if change.iter().chain(&dalpha).all(|&v| v == 0.0) {
-                    vec![0.0; change.len()]
-                } else {
-                    c.body.expand(&change, &dalpha)
-                };
+                let du = c.body.expand(&change, &dalpha);
                 let u: Vec<Real> = part
                     .dofs
                     .free
