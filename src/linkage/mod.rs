@@ -42,6 +42,7 @@ pub mod body_state;
 mod boundary_segments;
 mod convergence;
 mod dof_map;
+pub mod dynamics;
 mod equilibrium;
 pub mod fracture;
 pub mod generators;
