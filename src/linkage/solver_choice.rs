@@ -18,7 +18,7 @@ pub enum SolverChoice {
 }
 
 /// Free DOFs of a 3D body above which `auto` picks the iterative solver. Measured on box
-/// lattices (docs/PERFORMANCE.md): one multigrid solve beats one factorization from about
+/// lattices (docs/performance-history.md): one multigrid solve beats one factorization from about
 /// 10,000 DOFs; above 30,000 it is 3× faster and needs a fraction of the memory, and a
 /// linear run with several load schedules or a Newton run still favours it there.
 pub const AUTO_ITERATIVE_DOFS_3D: usize = 30_000;
@@ -28,7 +28,7 @@ pub const AUTO_ITERATIVE_DOFS_3D: usize = 30_000;
 /// and each contact step costs little; the coupled conjugate-gradient path instead solves at
 /// every Newton iteration (two 64,600-DOF boxes: 8 s of set-up and 0.5 s a step condensed,
 /// 41–144 s a step iteratively; a factorization of 86,000 DOFs takes 3.4 s, of 200,000 23 s
-/// and 2.7 GB: docs/PERFORMANCE.md).
+/// and 2.7 GB: docs/performance-history.md).
 pub const AUTO_CONTACT_ITERATIVE_DOFS_3D: usize = 100_000;
 
 /// Free DOFs of a 2D body above which `auto` picks the iterative solver: plane linkages

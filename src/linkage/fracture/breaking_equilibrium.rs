@@ -16,7 +16,8 @@
 //! member's two nodes to the root of the elimination tree, so a break costs a forward solve
 //! over those paths, sparse products with the earlier breaks' columns and one backward solve
 //! (independent subtrees side by side, the same bits on any number of threads), about half a
-//! full solve on the benchmark lattice (docs/PERFORMANCE.md, "Fracture").
+//! full solve on the benchmark lattice (docs/performance-history.md, "A break in the factor's
+//! space").
 //!
 //! A softening member (its material's `softening`, see [`saw_tooth`]) passes through its
 //! teeth the same way: each tooth is an event found like a break, and the drop of its
@@ -45,7 +46,7 @@ use std::time::Instant;
 /// costs `O(n r)` on top of the triangular solves, so `r` is kept well below the factor's fill.
 /// On the 108,860-member benchmark lattice a correction at r = 128 still costs a few percent
 /// of a solve, while a refactorization costs 16–23 solves: 128 halves the refactorizations of
-/// 64 for little more per break (see docs/PERFORMANCE.md, "Fracture").
+/// 64 for little more per break (see docs/performance-history.md, "Fracture").
 pub const DEFAULT_REFACTOR_EVERY: usize = 128;
 
 /// A break whose `1 − k gᵀ K⁻¹ g` is at most this leaves `K_ff` singular: a piece falls off

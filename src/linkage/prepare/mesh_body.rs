@@ -23,7 +23,8 @@ pub const MEMORY_LIMIT: u64 = 8_000_000_000;
 /// Estimated bytes per lattice vertex (its side, position and the lists made from them).
 const BYTES_PER_LATTICE_VERTEX: u64 = 64;
 /// Estimated bytes per lattice cube inside the part (12 tetrahedra, their 48 faces sorted,
-/// 72 member ends before duplicates go): measured peaks stay below this (docs/PERFORMANCE.md).
+/// 72 member ends before duplicates go): measured peaks stay below this
+/// (docs/performance-history.md, "Preparing a body from a mesh").
 const BYTES_PER_INSIDE_CELL: u64 = 5_000;
 /// Members per lattice cube inside the part (3 corner, 3 centre and 8 diagonal edges).
 const MEMBERS_PER_CELL: u64 = 14;
