@@ -11,7 +11,7 @@ use std::collections::HashMap;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MeshProblem {
     /// An edge with one face only: the mesh has a hole there.
-    #[error("the edge from vertex {} to vertex {} (at {:?} and {:?} m) belongs to face {face} only: the mesh is open there; a mesh obstacle must be closed (watertight): add the missing faces", .edge[0], .edge[1], .at[0], .at[1])]
+    #[error("the edge from vertex {} to vertex {} (at {:?} and {:?} m) belongs to face {face} only: the mesh is open there; it must be closed (watertight): add the missing faces", .edge[0], .edge[1], .at[0], .at[1])]
     Open {
         /// The edge's vertices, 1-based.
         edge: [usize; 2],
@@ -31,7 +31,7 @@ pub enum MeshProblem {
         faces: Vec<usize>,
     },
     /// Faces that cannot all agree (a Möbius-like, one-sided surface).
-    #[error("face {face} cannot be turned to agree with all its neighbours: the surface is one-sided; a mesh obstacle must enclose a volume")]
+    #[error("face {face} cannot be turned to agree with all its neighbours: the surface is one-sided; the mesh must enclose a volume")]
     OneSided {
         /// A face where the contradiction shows, 1-based.
         face: usize,

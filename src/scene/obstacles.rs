@@ -129,8 +129,12 @@ pub(crate) fn obstacle_from(
                 read_mesh(&path).map_err(|e| fail(format!("`file`: {e}")))?;
             // Turned outward as a whole (faces that disagree with their neighbours turned too),
             // as body patches are: contact pushes nodes out along the faces' normals.
-            let oriented = orient_outward(&vertices, &triangles)
-                .map_err(|p| fail(format!("`file`: {}: {p}", path.display())))?;
+            let oriented = orient_outward(&vertices, &triangles).map_err(|p| {
+                fail(format!(
+                    "`file`: {}: {p} (a mesh obstacle is a solid, not a two-sided sheet: its mesh must be closed)",
+                    path.display()
+                ))
+            })?;
             found = turned_faces(name, &path, &oriented.turned, triangles.len());
             let triangles = oriented.triangles;
             let _checked = mesh_collider(&vertices, &triangles).map_err(&fail)?;

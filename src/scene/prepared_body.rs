@@ -58,8 +58,14 @@ pub fn prepare_file(path: &Path, spacing: Real) -> Result<PreparedBody, String> 
         .unwrap_or_default();
     if extension == "stl" || extension == "obj" {
         let (vertices, triangles) = read_mesh(path)?;
-        let oriented = orient_outward(&vertices, &triangles)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+        // The problem is the mesh's; what it is for is said here: a body fills the solid
+        // the mesh encloses.
+        let oriented = orient_outward(&vertices, &triangles).map_err(|e| {
+            format!(
+                "{}: {e} (a body is prepared from the solid its mesh encloses: the mesh of a body must be closed)",
+                path.display()
+            )
+        })?;
         prepare_mesh(&vertices, &oriented.triangles, spacing)
             .map_err(|e| format!("{}: {e}", path.display()))
     } else {
