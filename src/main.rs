@@ -472,7 +472,13 @@ fn run_scenes(
     );
     let on_start = |world: &linkage::scene::World| {
         // Said before the run starts, so a user can stop it before it fills the disk.
-        if let Some(w) = linkage::scene::output_warning(world) {
+        // The scene's own warnings (a far `nearest` point, a load on held directions) too.
+        for w in world
+            .warnings
+            .iter()
+            .cloned()
+            .chain(linkage::scene::output_warning(world))
+        {
             bar.suspend(|| eprintln!("warn  {}: {w}", world.name));
         }
         bar.inc_length(world.steps as u64 + 1);

@@ -209,7 +209,18 @@ fn bundled_scenes_pass_the_check() {
         scenes.len(),
         "{stdout}"
     );
-    assert!(!stdout.contains("warn"), "{stdout}");
+    // The one scene warned about: paper_shell_large's inflation loads, one per generatrix,
+    // take in its node on the fixed ring, whose share goes into the reactions (meant: the
+    // warning says so, docs/SCENES.md, *Warnings*).
+    let warned: Vec<&str> = stdout.lines().filter(|l| l.contains("warn")).collect();
+    assert_eq!(warned.len(), 24, "{stdout}");
+    for w in warned {
+        assert!(w.contains("paper_shell_large.toml:"), "{w}");
+        assert!(
+            w.contains("held by a support in a direction it pushes"),
+            "{w}"
+        );
+    }
 }
 
 /// A closed unit cube (OBJ, counter-clockwise seen from outside) and a box lattice above it.

@@ -218,7 +218,15 @@ fn disk_on_floor_is_in_equilibrium() {
             assert!(c.depth <= 0.01 * mean_length);
         }
         touched = touched.max(result.bodies[0].contacts.len());
-        assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
+        // The rubber disk is linear and strained past 5 % from step 1 (2 cm down on a 10 cm
+        // radius): that warning is meant (docs/SCENES.md, *Warnings*); nothing else is said.
+        assert!(
+            summary.warnings.iter().all(|w| result.step == 1
+                && w.contains("body 'disk': member")
+                && w.contains("is strained")),
+            "{:?}",
+            summary.warnings
+        );
     }
     assert!(
         touched >= 3,

@@ -13,7 +13,7 @@ use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::prepared_body::prepared_geometry;
 use crate::scene::pressures::add_pressure;
-use crate::scene::selector::{select_nodes, vector};
+use crate::scene::selector::{far_nearest_warning, select_nodes, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
 use crate::scene::{OutputSettings, PictureSettings, PlotSettings, ResultFormat, World};
 use std::path::{Path, PathBuf};
@@ -205,9 +205,17 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut bodies: Vec<Body> = Vec::new();
     let mut prepared = std::collections::BTreeMap::new();
+    let mut warnings = Vec::new();
     for b in &spec.bodies {
         let mut report = None;
-        let body = build_body(b, &materials, (text, path), spec.steps, &at, &mut report)?;
+        let body = build_body(
+            b,
+            &materials,
+            (text, path),
+            spec.steps,
+            &at,
+            (&mut report, &mut warnings),
+        )?;
         if let Some(r) = report {
             prepared.insert(body.name.clone(), r);
         }
@@ -270,6 +278,7 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     Ok(World {
         obstacles,
         found,
+        warnings,
         contact,
         contact_table: spec.contact.is_some(),
         name: spec.name,
@@ -494,7 +503,7 @@ fn build_body(
     (text, scene): (&str, &Path),
     steps: usize,
     at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
-    report: &mut Option<PrepareReport>,
+    (report, warnings): (&mut Option<PrepareReport>, &mut Vec<String>),
 ) -> Result<Body, SceneError> {
     let folder = scene.parent().unwrap_or(Path::new("."));
     let spec = spanned.get_ref();
@@ -732,6 +741,9 @@ fn build_body(
         let sp = s.get_ref();
         let fail = |m: String| at(s.span(), format!("body '{}': support: {m}", spec.name));
         let nodes = select_nodes(&sp.selector(), &body).map_err(fail)?;
+        warnings.extend(
+            far_nearest_warning(&sp.selector(), &body, &nodes).map(|w| fail(w).to_string()),
+        );
         if sp.fix.is_empty() {
             return Err(fail(
                 "`fix` is empty: list the held directions, e.g. fix = [\"x\", \"y\"]".to_string(),
@@ -776,6 +788,9 @@ fn build_body(
         let lp = l.get_ref();
         let fail = |m: String| at(l.span(), format!("body '{}': load: {m}", spec.name));
         let nodes = select_nodes(&lp.selector(), &body).map_err(fail)?;
+        warnings.extend(
+            far_nearest_warning(&lp.selector(), &body, &nodes).map(|w| fail(w).to_string()),
+        );
         let force = match (&lp.force, &lp.total_force) {
             (Some(f), None) => vector(f, body.dimension, "force").map_err(fail)?,
             (None, Some(f)) => {
@@ -826,6 +841,20 @@ fn build_body(
                 ["x", "y", "z"][k]
             )));
         }
+        let lost: Vec<(usize, nalgebra::Vector3<crate::Real>)> = nodes
+            .iter()
+            .map(|&n| {
+                let h = held(n);
+                (
+                    n,
+                    force.map_with_location(|k, _, f| if h[k] { f } else { 0.0 }),
+                )
+            })
+            .filter(|(_, f)| *f != nalgebra::Vector3::zeros())
+            .collect();
+        warnings.extend(
+            partly_held_warning(key, force, nodes.len(), &lost, d).map(|w| fail(w).to_string()),
+        );
         let schedule = schedule(&lp.schedule).map_err(fail)?;
         for node in nodes {
             body.loads.push(NodalLoad {
@@ -841,4 +870,40 @@ fn build_body(
         add_pressure(&mut body, p.get_ref(), schedule).map_err(fail)?;
     }
     Ok(body)
+}
+
+/// The warning of a load of `force` per node (N) on `count` nodes, `lost` of which have it
+/// partly on directions a support holds (per node, 0-based, the part held, N): that part goes
+/// straight into the reactions. Names the nodes (the first 8), what they lose, the total
+/// lost and what the free nodes carry; `None` when nothing is lost.
+fn partly_held_warning(
+    key: &str,
+    force: nalgebra::Vector3<crate::Real>,
+    count: usize,
+    lost: &[(usize, nalgebra::Vector3<crate::Real>)],
+    d: usize,
+) -> Option<String> {
+    if lost.is_empty() {
+        return None;
+    }
+    let shown: Vec<String> = lost
+        .iter()
+        .take(8)
+        .map(|(n, _)| (n + 1).to_string())
+        .collect();
+    let more = if lost.len() > 8 { ", …" } else { "" };
+    let total_lost: nalgebra::Vector3<crate::Real> = lost.iter().map(|(_, f)| f).sum();
+    let applied = force * count as crate::Real;
+    let carried = applied - total_lost;
+    let v = |f: nalgebra::Vector3<crate::Real>| format!("{:?}", &f.as_slice()[..d]);
+    Some(format!(
+        "`{key}` puts {} N on each of {count} nodes, and {} of them (node{} {}{more}) are held by a support in a direction it pushes: {} N of the {} N in all goes straight into the reactions and moves nothing; the free nodes carry {} N. Leave the held nodes out of the selector (a smaller box, line or plane) or, with `total_force`, give the force the free nodes should share",
+        v(force),
+        lost.len(),
+        if lost.len() == 1 { "" } else { "s" },
+        shown.join(", "),
+        v(total_lost),
+        v(applied),
+        v(carried),
+    ))
 }

@@ -27,7 +27,8 @@ pub struct CheckReport {
     pub notes: Vec<String>,
     /// What loading the scene found and changed (mesh faces turned outward).
     pub found: Vec<String>,
-    /// What the run would do that a user may not want (more than 1 GiB of step files).
+    /// What the run would do that a user may not want: the scene's own warnings
+    /// ([`World::warnings`]), more than 1 GiB of step files.
     pub warnings: Vec<String>,
 }
 
@@ -56,7 +57,12 @@ pub fn check_world(world: &World) -> Result<CheckReport, RunError> {
         bodies: simulation.sizes(),
         notes,
         found: world.found.clone(),
-        warnings: output_warning(world).into_iter().collect(),
+        warnings: world
+            .warnings
+            .iter()
+            .cloned()
+            .chain(output_warning(world))
+            .collect(),
     })
 }
 

@@ -153,6 +153,7 @@ fn run_in(
                 }));
             }
             if step == 0 {
+                line.warnings.extend(world.warnings.iter().cloned());
                 line.warnings.extend(output_warning(world));
             }
             (line.peak_stress, line.stress_ratio) = peak_stress(&result, Some(world));

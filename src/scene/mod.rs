@@ -5,6 +5,7 @@ pub use self::check::{
     check_world, obstacle_offset_bytes, output_warning, step_file_bytes, stored_steps, CheckReport,
     BYTES_PER_VALUE, NPZ_BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
 };
+pub use self::contact_concentration::{CONCENTRATED_SHARE, NEIGHBOUR_SLOPE};
 pub use self::driver::{run, run_into, run_until, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
@@ -18,9 +19,10 @@ pub use self::results::{
 pub use self::run_error::RunError;
 pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS};
 pub use self::scene_digest::scene_digest;
-pub use self::selector::select_nodes;
+pub use self::selector::{far_nearest_warning, select_nodes, FAR_NEAREST};
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
+pub use self::strain_warning::LINEAR_STRAIN_WARNING;
 pub use self::sweep::{expand_sweep, SweepMode, Variant};
 pub use self::vtk::{write_vtk, VtkError};
 pub use self::vtu_arrays::VtkEncoding;
@@ -32,6 +34,7 @@ pub mod batch;
 mod bounds;
 mod build;
 mod check;
+mod contact_concentration;
 mod contact_pairs;
 mod driver;
 mod instability;
@@ -58,6 +61,7 @@ mod simulation;
 pub mod spec;
 mod step_writer;
 mod stored_run;
+mod strain_warning;
 pub mod sweep;
 mod vtk;
 mod vtu_arrays;

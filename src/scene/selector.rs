@@ -124,6 +124,33 @@ pub fn select_nodes(spec: &SelectorSpec, body: &Body) -> Result<Vec<usize>, Stri
     Ok(picked)
 }
 
+/// A `nearest` node farther than this fraction of the body's size (its bounding diagonal) from
+/// the point given is warned about: the point was probably mistyped (`[12, 300]` for `[12, 3]`).
+pub const FAR_NEAREST: Real = 0.1;
+
+/// The warning of a `nearest` selector whose picked node (0-based `picked`, as
+/// [`select_nodes`] chose it) lies farther than [`FAR_NEAREST`] of the body's size from the
+/// point given: the point, the node and the distance (`None` for other selectors, a point near
+/// its node, or a point that cannot be read).
+pub fn far_nearest_warning(spec: &SelectorSpec, body: &Body, picked: &[usize]) -> Option<String> {
+    let given = spec.nearest.as_ref()?;
+    let point = vector(given, body.dimension, "nearest").ok()?;
+    let node = *picked.first()?;
+    let at = body.nodes.get(node)?;
+    let distance = (at - point).norm();
+    let size = body.size();
+    if distance.is_nan() || distance <= FAR_NEAREST * size {
+        return None;
+    }
+    let d = body.dimension.dofs_per_node();
+    Some(format!(
+        "`nearest` = {given:?} picks node {} at {:?} m, {distance:.4} m away from the point: more than a tenth of the body's size ({size:.4} m, its bounding diagonal); no node is near that point: check its coordinates against the body, which spans {}",
+        node + 1,
+        &at.as_slice()[..d],
+        extent(body)
+    ))
+}
+
 /// A point or direction with one component per dimension of the body, as a 3-vector.
 pub fn vector(v: &[Real], dimension: Dimension, key: &str) -> Result<Vector3<Real>, String> {
     let d = dimension.dofs_per_node();

@@ -6,12 +6,14 @@ use crate::contact::{
 };
 use crate::linkage::fracture::{breaks_members, BreakEvent, FractureState};
 use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
+use crate::scene::contact_concentration::concentrated_contact_warnings;
 use crate::scene::instability::InstabilityWatch;
 use crate::scene::results::{
     BodyFracture, BodyResult, BodySize, BreakRecord, Collapse, ContactForce, PairForce, StepResult,
     StepSummary, SummaryBreak,
 };
 use crate::scene::run_error::RunError;
+use crate::scene::strain_warning::large_strain_warning;
 use crate::scene::World;
 use crate::Real;
 
@@ -33,6 +35,10 @@ pub struct Simulation<'w> {
     pub solver: WorldSolver,
     /// What the instability warnings remember of the previous step.
     watch: InstabilityWatch,
+    /// Per body, whether its strains were warned about already ([`large_strain_warning`]).
+    strain_warned: Vec<bool>,
+    /// The contact pairs (body, other) warned about as carried by one node already.
+    concentration_warned: Vec<(String, String)>,
     /// Breaking members in a scene with contact: the bodies as they break.
     fracture: Option<ContactFracture>,
     /// Per body, in a scene solved body by body, the watch for its self-contact (breaking
@@ -110,6 +116,8 @@ impl<'w> Simulation<'w> {
             world,
             solver,
             watch: InstabilityWatch::default(),
+            strain_warned: vec![false; world.bodies.len()],
+            concentration_warned: Vec::new(),
             fracture,
             self_watch,
         })
@@ -188,7 +196,57 @@ impl<'w> Simulation<'w> {
             .watch
             .warnings(&world.bodies, step, &states, &summary.contact_forces);
         summary.warnings.extend(warnings);
+        summary
+            .warnings
+            .extend(self.slip_warnings(step, &states, &contacts));
         Ok((result, summary))
+    }
+
+    /// The warnings of `step` about what a user may not have meant, each once per run (from
+    /// step 0 again when the run starts over): a linear body strained past a few percent
+    /// ([`large_strain_warning`]), and at the last step a contact carried by one node
+    /// ([`concentrated_contact_warnings`]: at the full load; while a press starts, one node
+    /// touching first is no concern).
+    fn slip_warnings(
+        &mut self,
+        step: usize,
+        states: &[StepState],
+        contacts: &[Vec<NodeContact>],
+    ) -> Vec<String> {
+        let world = self.world;
+        if step == 0 {
+            self.strain_warned = vec![false; world.bodies.len()];
+            self.concentration_warned.clear();
+        }
+        let mut out = Vec::new();
+        for (k, (body, state)) in world.bodies.iter().zip(states).enumerate() {
+            if let Some(warned) = self.strain_warned.get_mut(k).filter(|w| !**w) {
+                if let Some(w) = large_strain_warning(body, step, state) {
+                    *warned = true;
+                    out.push(w);
+                }
+            }
+            let Some(touching) = contacts
+                .get(k)
+                .filter(|c| step == world.steps && !c.is_empty())
+            else {
+                continue;
+            };
+            let positions: Vec<nalgebra::Vector3<Real>> = body
+                .nodes
+                .iter()
+                .zip(&state.displacements)
+                .map(|(x, u)| x + u)
+                .collect();
+            out.extend(concentrated_contact_warnings(
+                body,
+                step,
+                &positions,
+                touching,
+                &mut self.concentration_warned,
+            ));
+        }
+        out
     }
 
     /// Solve `step` with the contact solver (breaking members event by event when a body

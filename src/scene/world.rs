@@ -48,6 +48,10 @@ pub struct World {
     /// What building the world changed that a user may want to know (mesh faces turned
     /// outward), as `linkage check` says it.
     pub found: Vec<String>,
+    /// What the scene asks that a user may not have meant, known before solving (a `nearest`
+    /// node far from its point, a load partly on held directions), each with the scene file
+    /// and line: `linkage check` prints them, `linkage run` puts them in step 0's warnings.
+    pub warnings: Vec<String>,
     /// Contact settings (`[contact]`).
     pub contact: ContactSettings,
     /// Whether the scene has a `[contact]` table (contact between its bodies is looked for).
