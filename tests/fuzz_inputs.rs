@@ -7,12 +7,12 @@
 //! `LINKAGE_FUZZ_CASES` sets the number of cases (default [`DEFAULT_CASES`]) and
 //! `LINKAGE_FUZZ_SEED` the seed (default fixed, so CI is deterministic).
 
-use linkage::scene::{load_scene, run, RunError, World};
+use linkage::scene::{batch, build_world, load_scene, run, RunError, World};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
@@ -83,6 +83,100 @@ enum Edit {
     EmptyArray(usize),
     /// A table (`[...]` header to the next header) written twice.
     DuplicateSection(usize),
+    /// `FEATURES[i]` added where its kind goes (scene files only).
+    AddFeature(usize),
+}
+
+/// Where a feature's lines go in a scene file.
+#[derive(Clone, Copy, Debug)]
+enum Place {
+    /// Before the first table: a top-level key.
+    Top,
+    /// Into the first `[[materials]]` table, after its header.
+    Material,
+    /// Into the first `[[bodies]]` table, after its header.
+    Body,
+    /// At the end: a table, or a table of the last body (`[[bodies.pressures]]`).
+    End,
+}
+
+/// Features a mutation adds to a scene, so that the mutations that follow reach their keys
+/// whatever the bundled scenes have: friction, contact pairs, fracture, softening, scatter,
+/// meshes and outlines (bodies and obstacles), pressure, gravity, sweeps and self-contact.
+/// `{body}` is the scene's first body and `{other}` its first obstacle (else that body), 2D and
+/// 3D forms side by side (the wrong one is refused, as it should be).
+const FEATURES: &[(Place, &str)] = &[
+    (Place::Top, "gravity = [0.0, -9.81]"),
+    (Place::Top, "gravity = [0.0, -9.81, 0.0]"),
+    (Place::Top, "gravity = [0.0, -9.81]\ngravity_schedule = [0.5, 1.0, 2.0]"),
+    (Place::Material, "density = 7850.0"),
+    (Place::Material, "failure = \"break\"\nstrength = 3e6\nscatter = { weibull_modulus = 4.0, seed = 7 }"),
+    (Place::Material, "failure = \"break\"\ntensile_strength = 2e6\nsoftening = { fracture_energy = 50.0, teeth = 3 }"),
+    (Place::Material, "behaviour = \"tension_only\""),
+    (Place::Body, "kinematics = \"large\""),
+    (Place::End, "[contact]\nfriction = 0.3\nstick_stiffness = 1e9"),
+    (Place::End, "[contact]\nself = true"),
+    (Place::End, "[contact]\n[[contact.pairs]]\nbetween = [\"{body}\", \"{other}\"]\nfriction = 0.4"),
+    (Place::End, "[[contact.pairs]]\nbetween = [\"{body}\", \"{body}\"]\nfriction = 0.2\nstick_stiffness = 1e8"),
+    (Place::End, "[[obstacles]]\nname = \"fuzz_ball\"\nshape = \"ball\"\ncenter = [0.0, -2.0]\nradius = 0.5\ntravel = [0.0, 0.5]"),
+    (Place::End, "[[obstacles]]\nname = \"fuzz_ball\"\nshape = \"ball\"\ncenter = [0.0, -2.0, 0.0]\nradius = 0.5"),
+    (Place::End, "[[obstacles]]\nname = \"fuzz_mesh\"\nshape = \"mesh\"\nfile = \"ring.obj\"\ntravel = [0.0, 0.0, 0.1]"),
+    (Place::End, "[[bodies.pressures]]\nnodes = [1, 2, 3]\npressure = 1e4"),
+    (Place::End, "[[bodies.pressures]]\ninside = { min = [-10.0, -10.0], max = [10.0, 10.0] }\npressure = -1e3\nschedule = [1.0, 0.5, 2.0]"),
+    (Place::End, "[[bodies.loads]]\nnearest = [0.0, 300.0]\nforce = [0.0, -1e3]"),
+    (Place::End, "[[bodies.loads]]\non_line = { point = [0.0, 0.0], direction = [1.0, 0.0] }\ntotal_force = [1e3, -1e3]"),
+    (Place::End, "[[bodies]]\nname = \"fuzz_outline\"\noutline = { file = \"plate_with_hole.txt\", spacing = 0.05 }\noffset = [0.0, 3.0]\n[[bodies.supports]]\nnearest = [0.0, 3.0]\nfix = [\"x\", \"y\"]"),
+    (Place::End, "[[bodies]]\nname = \"fuzz_points\"\noutline = { points = [[0.0, 0.0], [0.4, 0.0], [0.4, 0.2], [0.0, 0.2]], spacing = 0.1 }\noffset = [0.0, -3.0]\n[[bodies.supports]]\non_line = { point = [0.0, -3.0], direction = [1.0, 0.0] }\nfix = [\"x\", \"y\"]"),
+    (Place::End, "[[bodies]]\nname = \"fuzz_ring\"\nmesh = { file = \"ring.obj\", spacing = 0.008 }\noffset = [0.0, 0.0, 1.0]\n[[bodies.supports]]\ninside = { min = [-1.0, -1.0, 0.0], max = [1.0, 0.01, 2.0] }\nfix = [\"x\", \"y\", \"z\"]"),
+    (Place::End, "[sweep]\n\"materials.1.youngs_modulus\" = [1e9, 2e11]"),
+    (Place::End, "[sweep]\nmode = \"zip\"\n\"materials.1.area\" = [1e-4, 2e-4]\n\"steps\" = [1, 2]"),
+    (Place::End, "[sweep]\n\"bodies.1.supports.1.fix\" = [[\"x\"], [\"x\", \"y\"]]"),
+];
+
+/// The first `name = "..."` after a line starting with `header`.
+fn first_name_after(text: &str, header: &str) -> Option<String> {
+    let mut inside = false;
+    for line in text.lines() {
+        let t = line.trim_start();
+        if t.starts_with('[') {
+            inside = t.starts_with(header);
+            continue;
+        }
+        if inside {
+            if let Some(v) = t.strip_prefix("name = ") {
+                return Some(v.split('#').next()?.trim().trim_matches('"').to_string());
+            }
+        }
+    }
+    None
+}
+
+/// `text` with `FEATURES[i]` added at its place.
+fn add_feature(text: &str, i: usize) -> String {
+    let (place, fragment) = FEATURES[i % FEATURES.len()];
+    let body = first_name_after(text, "[[bodies]]").unwrap_or_else(|| "body".into());
+    let other = first_name_after(text, "[[obstacles]]").unwrap_or_else(|| body.clone());
+    let fragment = fragment.replace("{body}", &body).replace("{other}", &other);
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let after = |header: &str| {
+        lines
+            .iter()
+            .position(|l| l.trim_start().starts_with(header))
+            .map(|k| k + 1)
+    };
+    let at = match place {
+        Place::Top => Some(0),
+        Place::Material => after("[[materials]]"),
+        Place::Body => after("[[bodies]]"),
+        Place::End => None,
+    };
+    match at {
+        Some(k) => lines.insert(k.min(lines.len()), fragment),
+        None => lines.push(fragment),
+    }
+    let mut s = lines.join("\n");
+    s.push('\n');
+    s
 }
 
 /// An edit of the scene file (`file` 0) or of one of its node and link files.
@@ -104,6 +198,7 @@ fn edit_strategy() -> impl Strategy<Value = Edit> {
         2 => (i(), 0..OTHER_VALUES.len() + 2).prop_map(|(a, b)| Edit::ChangeType(a, b)),
         1 => i().prop_map(Edit::EmptyArray),
         1 => i().prop_map(Edit::DuplicateSection),
+        3 => i().prop_map(Edit::AddFeature),
     ]
 }
 
@@ -339,6 +434,7 @@ fn apply(text: &str, edit: &Edit) -> String {
             let section: Vec<String> = lines[start..end].to_vec();
             lines.splice(end..end, section);
         }
+        Edit::AddFeature(i) => return add_feature(text, i),
         _ => {}
     }
     join(&lines)
@@ -363,18 +459,29 @@ fn mutate(scene: &Scene, mutations: &[Mutation]) -> Files {
         .chain(scene.files.iter().map(|(_, t)| t.clone()))
         .collect();
     for m in mutations {
-        let k = m.file % texts.len();
+        let k = match m.edit {
+            Edit::AddFeature(_) => 0,
+            _ => m.file % texts.len(),
+        };
         texts[k] = apply(&texts[k], &m.edit);
+    }
+    // The bundled files a feature names that the scene did not, as bundled.
+    let mut aux: Vec<(String, String)> = scene
+        .files
+        .iter()
+        .zip(&texts[1..])
+        .map(|((name, _), t)| (name.clone(), t.clone()))
+        .collect();
+    for name in ["ring.obj", "plate_with_hole.txt"] {
+        if texts[0].contains(&format!("\"{name}\"")) && !aux.iter().any(|(n, _)| n == name) {
+            let text = std::fs::read_to_string(scenes_dir().join(name)).unwrap();
+            aux.push((name.to_string(), text));
+        }
     }
     Files {
         scene_file: scene.file.clone(),
         scene: texts[0].clone(),
-        aux: scene
-            .files
-            .iter()
-            .zip(&texts[1..])
-            .map(|((name, _), t)| (name.clone(), t.clone()))
-            .collect(),
+        aux,
     }
 }
 
@@ -405,6 +512,51 @@ enum Outcome {
     Stopped(PathBuf),
     /// Ran: another `Err` (its message, read through `Debug` in failure messages).
     Failed(#[allow(dead_code)] String),
+    /// A scene with `[sweep]`, its variants run as a batch does: per variant its results
+    /// folder and whether every step was solved.
+    Swept(Vec<(PathBuf, bool)>),
+}
+
+/// Variants of a swept case: more are not run (too slow for a fuzz case).
+const MAX_VARIANTS: usize = 4;
+
+/// A scene with `[sweep]` run as `linkage run` runs it: its variants planned, each built and
+/// run into `out/<name>/<k>/`.
+fn run_sweep(path: &Path, out: &Path) -> Outcome {
+    let Ok(jobs) = batch::plan_jobs(&[path.to_path_buf()]) else {
+        return Outcome::Refused;
+    };
+    if jobs.len() > MAX_VARIANTS {
+        return Outcome::TooLarge;
+    }
+    let built: Vec<World> = jobs
+        .iter()
+        .filter_map(|j| j.text.as_ref().ok())
+        .filter_map(|text| build_world(text, path).ok())
+        .collect();
+    if built.is_empty() {
+        return Outcome::Refused;
+    }
+    if built.iter().any(is_too_large) {
+        return Outcome::TooLarge;
+    }
+    let stop = AtomicBool::new(false);
+    let ran = jobs
+        .iter()
+        .map(|job| {
+            let (ran, _) = batch::run_job(
+                job,
+                out,
+                batch::JobSettings::default(),
+                None,
+                &|_: &World| {},
+                &|| {},
+                &stop,
+            );
+            (job.folder(out), matches!(ran, batch::Ran::Solved { .. }))
+        })
+        .collect();
+    Outcome::Swept(ran)
 }
 
 fn is_too_large(world: &World) -> bool {
@@ -420,7 +572,7 @@ fn known_issue(_files: &Files) -> Option<&'static str> {
 }
 
 /// Counts of outcomes, printed at the end.
-static COUNTS: [AtomicUsize; 7] = [const { AtomicUsize::new(0) }; 7];
+static COUNTS: [AtomicUsize; 8] = [const { AtomicUsize::new(0) }; 8];
 
 /// Runs `case`; returns its outcome's index in [`COUNTS`].
 fn run_case(scenes: &[Scene], case: &Case) -> Result<usize, TestCaseError> {
@@ -441,7 +593,10 @@ fn run_case(scenes: &[Scene], case: &Case) -> Result<usize, TestCaseError> {
     {
         let (path, out) = (path.clone(), out.clone());
         std::thread::spawn(move || {
+            let swept = std::fs::read_to_string(&path)
+                .is_ok_and(|t| t.lines().any(|l| l.trim_start().starts_with("[sweep]")));
             let outcome = std::panic::catch_unwind(|| match load_scene(&path) {
+                _ if swept => run_sweep(&path, &out),
                 Err(_) => Outcome::Refused,
                 Ok(world) if is_too_large(&world) => Outcome::TooLarge,
                 Ok(world) => match run(&world, &out, &|| {}) {
@@ -482,6 +637,7 @@ fn run_case(scenes: &[Scene], case: &Case) -> Result<usize, TestCaseError> {
         Outcome::Ran => 2,
         Outcome::Stopped(_) => 3,
         Outcome::Failed(_) => 4,
+        Outcome::Swept(_) => 7,
     };
     check_output(dir.path(), &files, &outcome).map_err(|problem| {
         TestCaseError::fail(format!("{problem} (outcome {outcome:?})\n{}", describe()))
@@ -515,6 +671,30 @@ fn check_output(dir: &Path, files: &Files, outcome: &Outcome) -> Result<(), Stri
         return Err(format!("out/ holds {hidden} (a staging folder)"));
     }
     match outcome {
+        Outcome::Swept(variants) => {
+            // One folder per scene name holding the variants' folders, and nothing else.
+            if entries.len() > 1 {
+                return Err(format!("a sweep left {entries:?} in out/, not one folder"));
+            }
+            for entry in &entries {
+                for inner in std::fs::read_dir(out.join(entry)).map_err(|e| e.to_string())? {
+                    let inner = inner.map_err(|e| e.to_string())?.path();
+                    if !variants.iter().any(|(folder, _)| *folder == inner) {
+                        return Err(format!(
+                            "a sweep left {} beside its variants' folders",
+                            inner.display()
+                        ));
+                    }
+                }
+            }
+            for (folder, solved) in variants {
+                if *solved {
+                    check_ran(folder)?;
+                } else if folder.exists() {
+                    check_stopped(folder)?;
+                }
+            }
+        }
         Outcome::Refused | Outcome::TooLarge | Outcome::Failed(_) => {
             if !entries.is_empty() {
                 return Err(format!("a run that wrote nothing left {entries:?} in out/"));
@@ -524,12 +704,7 @@ fn check_output(dir: &Path, files: &Files, outcome: &Outcome) -> Result<(), Stri
             if entries.len() != 1 {
                 return Err(format!("a run left {entries:?} in out/, not one folder"));
             }
-            let results = out.join(&entries[0]);
-            let summary = read_json(&results.join("summary.json"))?;
-            if summary.get("failure").is_some() {
-                return Err("a run that succeeded has a failure in summary.json".into());
-            }
-            check_results(&results)?;
+            check_ran(&out.join(&entries[0]))?;
         }
         Outcome::Stopped(results) => {
             if entries.len() != 1 || !results.starts_with(&out) || !results.is_dir() {
@@ -538,26 +713,42 @@ fn check_output(dir: &Path, files: &Files, outcome: &Outcome) -> Result<(), Stri
                     results.display()
                 ));
             }
-            let summary = read_json(&results.join("summary.json"))?;
-            if !summary.get("failure").is_some_and(|f| f.is_string()) {
-                return Err("a stopped run's summary.json has no failure".into());
-            }
-            let step_zero = std::fs::read_dir(results.join("steps"))
-                .map(|r| {
-                    r.flatten().any(|e| {
-                        let name = e.file_name().to_string_lossy().into_owned();
-                        name.strip_suffix(".json")
-                            .is_some_and(|stem| stem.parse::<usize>() == Ok(0))
-                    })
-                })
-                .unwrap_or(false);
-            if !step_zero {
-                return Err("a stopped run kept no step 0".into());
-            }
-            check_results(results)?;
+            check_stopped(results)?;
         }
     }
     Ok(())
+}
+
+/// The folder of a run that succeeded: its summary has no failure, its results no NaN.
+fn check_ran(results: &Path) -> Result<(), String> {
+    let summary = read_json(&results.join("summary.json"))?;
+    if summary.get("failure").is_some() {
+        return Err("a run that succeeded has a failure in summary.json".into());
+    }
+    check_results(results)
+}
+
+/// The folder of a run stopped after step 0: its summary says why, step 0 is kept, its
+/// results have no NaN.
+fn check_stopped(results: &Path) -> Result<(), String> {
+    let summary = read_json(&results.join("summary.json"))?;
+    if !summary.get("failure").is_some_and(|f| f.is_string()) {
+        return Err("a stopped run's summary.json has no failure".into());
+    }
+    let step_zero = std::fs::read_dir(results.join("steps"))
+        .map(|r| {
+            r.flatten().any(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                name.strip_suffix(".json")
+                    .or_else(|| name.strip_suffix(".npz"))
+                    .is_some_and(|stem| stem.parse::<usize>() == Ok(0))
+            })
+        })
+        .unwrap_or(false);
+    if !step_zero {
+        return Err("a stopped run kept no step 0".into());
+    }
+    check_results(results)
 }
 
 fn read_json(path: &Path) -> Result<serde_json::Value, String> {
@@ -663,7 +854,7 @@ fn mutated_scenes_panic_hang_write_nan_or_leave_litter_never() {
     );
     let strategy = (
         0..scenes.len(),
-        proptest::collection::vec(mutation_strategy(), 1..=3),
+        proptest::collection::vec(mutation_strategy(), 1..=4),
     )
         .prop_map(|(scene, mutations)| Case { scene, mutations });
     let collect = std::env::var("LINKAGE_FUZZ_COLLECT").is_ok_and(|v| v == "1");
@@ -678,6 +869,13 @@ fn mutated_scenes_panic_hang_write_nan_or_leave_litter_never() {
             outcome => outcome?,
         };
         COUNTS[outcome].fetch_add(1, Ordering::Relaxed);
+        let done: usize = COUNTS.iter().map(|c| c.load(Ordering::Relaxed)).sum();
+        if done.is_multiple_of(500) {
+            eprintln!(
+                "fuzz: {done} cases, {:.0} s",
+                started.elapsed().as_secs_f64()
+            );
+        }
         Ok(())
     });
     let names = [
@@ -688,6 +886,7 @@ fn mutated_scenes_panic_hang_write_nan_or_leave_litter_never() {
         "failed",
         "known issue",
         "findings",
+        "swept",
     ];
     let counts: BTreeMap<&str, usize> = names
         .iter()
