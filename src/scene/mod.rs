@@ -18,7 +18,7 @@ pub use self::results::{
 pub use self::run_error::RunError;
 pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS};
 pub use self::scene_digest::scene_digest;
-pub use self::selector::select_nodes;
+pub use self::selector::{select_nodes, select_nodes_in};
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
 pub use self::sweep::{expand_sweep, SweepMode, Variant};
@@ -34,6 +34,7 @@ mod build;
 mod check;
 mod contact_pairs;
 mod driver;
+pub mod import;
 mod instability;
 mod link_lines;
 mod mesh_file;
