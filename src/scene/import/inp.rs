@@ -114,7 +114,8 @@ impl Deck {
                     Some(f) if !f.is_empty() => integer(place, f, "the increment")?,
                     _ => 1,
                 };
-                if step <= 0 || last < first || (last - first) / step > 10_000_000 {
+                let span = last.checked_sub(first);
+                if step <= 0 || span.is_none_or(|s| s < 0 || s / step > 10_000_000) {
                     return Err(place.error(format!(
                         "GENERATE {first}, {last}, {step}: give first ≤ last and an increment of 1 or more"
                     )));
@@ -571,7 +572,9 @@ fn model_of_deck(path: &Path, deck: Deck) -> Result<ImportedModel, ModelFileErro
         let name = if areas.iter().all(|&a| a == section.area) {
             one_word(&m.name)
         } else {
-            format!("{}_{}", one_word(&m.name), one_word(&section.elset))
+            let set = Deck::set(&deck.elsets, &section.elset)
+                .map_or(section.elset.as_str(), |s| s.name.as_str());
+            format!("{}_{}", one_word(&m.name), one_word(set))
         };
         of_section[s] = match materials.iter().position(|o| o.name == name) {
             Some(k) => k,

@@ -394,6 +394,7 @@ fn read_elements(
     c.size("the largest element tag")?;
     let mut read = 0;
     for _ in 0..blocks {
+        c.skip_space();
         let header = c.pos;
         let dim = c.int("the block's entity dimension")?;
         let entity = c.int("the block's entity tag")?;

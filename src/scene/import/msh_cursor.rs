@@ -43,6 +43,16 @@ impl<'a> MshCursor<'a> {
         ModelFileError::at(self.path, self.line_of(self.pos), message)
     }
 
+    /// Skip the whitespace before the next ASCII value (binary: nothing), so that the
+    /// position names the value's line.
+    pub(crate) fn skip_space(&mut self) {
+        if !self.binary {
+            while self.pos < self.bytes.len() && self.bytes[self.pos].is_ascii_whitespace() {
+                self.pos += 1;
+            }
+        }
+    }
+
     /// The bytes left.
     pub(crate) fn remaining(&self) -> usize {
         self.bytes.len().saturating_sub(self.pos)

@@ -188,15 +188,18 @@ fn directions(fixed: &[bool; 3], d: usize) -> String {
 fn supports_and_loads(model: &ImportedModel) -> String {
     let d = model.geometry.dimension.dofs_per_node();
     let mut text = String::new();
-    let mut kinds: Vec<(([bool; 3], Vector3<Real>), Vec<usize>)> = Vec::new();
+    // Nodes held alike: directions, displacement, nodes.
+    let mut kinds: Vec<([bool; 3], Vector3<Real>, Vec<usize>)> = Vec::new();
     for s in &model.supports {
-        let key = (s.fixed, s.displacement);
-        match kinds.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, nodes)) => nodes.push(s.node),
-            None => kinds.push((key, vec![s.node])),
+        match kinds
+            .iter_mut()
+            .find(|(f, u, _)| *f == s.fixed && *u == s.displacement)
+        {
+            Some((_, _, nodes)) => nodes.push(s.node),
+            None => kinds.push((s.fixed, s.displacement, vec![s.node])),
         }
     }
-    for ((fixed, displacement), nodes) in &kinds {
+    for (fixed, displacement, nodes) in &kinds {
         let _ = writeln!(text, "\n[[bodies.supports]]\nnodes = {}", node_list(nodes));
         let _ = writeln!(text, "fix = {}", directions(fixed, d));
         if *displacement != Vector3::zeros() {
@@ -266,7 +269,9 @@ fn scene_of_model(
     }
     text.push_str(&supports_and_loads(model));
     if !model.groups.is_empty() {
-        text.push_str("\n# The model file's groups: support and load them by uncommenting.\n");
+        text.push_str(
+            "\n# The model file's groups as node lists, to support or load (uncomment and edit).\n",
+        );
         for g in &model.groups {
             let fix = match model.geometry.dimension {
                 Dimension::Two => "[\"x\", \"y\"]",
