@@ -107,6 +107,16 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Write what a model file reads as (a gmsh .msh, an Abaqus/CalculiX .inp, or a scene
+    /// whose bodies have `model =`) as the paper's files and a scene DIR/<stem>.toml, to see
+    /// and edit.
+    Import {
+        /// A .msh (MSH 4.1), .inp or scene .toml file.
+        input: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Prepare a body from a closed OBJ/STL mesh (3D) or an outline file (2D): write
     /// DIR/<stem>.nodes, .links (and .patches) and print the quality report.
     Prepare {
@@ -337,6 +347,7 @@ fn main() -> ExitCode {
         ),
         Command::Check { scenes } => check_scenes(&scenes),
         Command::Export { scene, out } => export(&scene, &out),
+        Command::Import { input, out } => import(&input, &out),
         Command::Prepare {
             input,
             spacing,
@@ -688,6 +699,27 @@ fn prepare(input: &Path, spacing: f64, out: &Path) -> Result<()> {
         println!("wrote {}", path.display());
     }
     println!("{}", body.report);
+    Ok(())
+}
+
+fn import(input: &Path, out: &Path) -> Result<()> {
+    create_out_folder(out)?;
+    let imported = linkage::scene::import::import_file(input, out)?;
+    for path in &imported.files {
+        println!("wrote {}", path.display());
+    }
+    for w in &imported.warnings {
+        println!("warning: {w}");
+    }
+    if imported.complete {
+        println!("run it: linkage run {}", imported.scene.display());
+    } else {
+        println!(
+            "{} needs a material and supports before it runs: edit it (its groups are listed at the end), or give `linkage import` a scene whose body has model = {:?}",
+            imported.scene.display(),
+            input.file_name().unwrap_or_default()
+        );
+    }
     Ok(())
 }
 

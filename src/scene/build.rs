@@ -9,11 +9,12 @@ use crate::linkage::{
 };
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::contact_pairs::friction_settings;
+use crate::scene::import::{read_model, NodeGroup};
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::prepared_body::prepared_geometry;
 use crate::scene::pressures::add_pressure;
-use crate::scene::selector::{far_nearest_warning, select_nodes, vector};
+use crate::scene::selector::{far_nearest_warning, select_nodes_in, vector};
 use crate::scene::spec::{BodySpec, MaterialSpec, SceneSpec};
 use crate::scene::{OutputSettings, PictureSettings, PlotSettings, ResultFormat, World};
 use std::path::{Path, PathBuf};
@@ -206,19 +207,18 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     let mut bodies: Vec<Body> = Vec::new();
     let mut prepared = std::collections::BTreeMap::new();
     let mut warnings = Vec::new();
+    let mut found = Vec::new();
     for b in &spec.bodies {
-        let mut report = None;
-        let body = build_body(
-            b,
-            &materials,
-            (text, path),
-            spec.steps,
-            &at,
-            (&mut report, &mut warnings),
-        )?;
-        if let Some(r) = report {
+        let mut notes = BodyNotes::default();
+        let body = build_body(b, &materials, (text, path), spec.steps, &at, &mut notes)?;
+        if let Some(r) = notes.report {
             prepared.insert(body.name.clone(), r);
         }
+        found.extend(notes.found);
+        warnings.extend(notes.warnings);
+        // A model file's materials follow the scene's, with their densities.
+        let density: Vec<Option<crate::Real>> =
+            density.iter().copied().chain(notes.densities).collect();
         if bodies.iter().any(|o| o.name == body.name) {
             return Err(at(
                 b.span(),
@@ -236,7 +236,6 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     let contact = contact_settings(spec.contact.as_ref().map(|c| c.get_ref()))
         .map_err(|e| at(spec.contact.as_ref().map_or(0..0, |c| c.span()), e))?;
     let mut obstacles: Vec<Obstacle> = Vec::new();
-    let mut found = Vec::new();
     for o in &spec.obstacles {
         let dimension = bodies[0].dimension;
         if bodies.iter().any(|b| b.dimension != dimension) {
@@ -497,13 +496,27 @@ fn beyond_bound(nodes: &[nalgebra::Vector3<crate::Real>]) -> Option<(usize, crat
     })
 }
 
+/// What building one body tells besides the body.
+#[derive(Default)]
+struct BodyNotes {
+    /// The quality report of a body prepared from a mesh or an outline.
+    report: Option<PrepareReport>,
+    /// Densities (kg/m³) of the materials a model file adds after the scene's, in order.
+    densities: Vec<Option<crate::Real>>,
+    /// What a model file held but the body does not use, for `linkage check`.
+    found: Vec<String>,
+    /// Slips found while building the body (a far `nearest` point, a load partly on held
+    /// directions), for the run's warnings.
+    warnings: Vec<String>,
+}
+
 fn build_body(
     spanned: &Spanned<BodySpec>,
     materials: &[Material],
     (text, scene): (&str, &Path),
     steps: usize,
     at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
-    (report, warnings): (&mut Option<PrepareReport>, &mut Vec<String>),
+    notes: &mut BodyNotes,
 ) -> Result<Body, SceneError> {
     let folder = scene.parent().unwrap_or(Path::new("."));
     let spec = spanned.get_ref();
@@ -606,17 +619,96 @@ fn build_body(
 
     let generated = generated_by(spec).iter().filter(|g| **g).count();
     let from_files = spec.nodes.is_some() || spec.links.is_some();
-    if generated + usize::from(from_files) != 1 {
+    if generated + usize::from(from_files) + usize::from(spec.model.is_some()) != 1 {
         return Err(here(
-            "give the geometry either as files (`nodes` and `links`, optionally `patches`) or as exactly one generator (`disk`, `rectangle`, `cylindrical_shell`, `box_lattice`, `mesh`, `outline`)".to_string(),
+            "give the geometry either as files (`nodes` and `links`, optionally `patches`), as a `model` file (.msh, .inp) or as exactly one generator (`disk`, `rectangle`, `cylindrical_shell`, `box_lattice`, `mesh`, `outline`)".to_string(),
         ));
     }
+    // Named node groups of a model file, for `group =` selectors.
+    let mut groups: Vec<NodeGroup> = Vec::new();
     let mut body = Body::new(&spec.name, Dimension::Two);
     body.materials = materials.to_vec();
     body.kinematics = kinematics;
     body.newton = newton;
     body.solver = solver;
-    if from_files {
+    if let Some(file) = &spec.model {
+        if spec.patches.is_some() {
+            return Err(here(
+                "`patches` goes with `nodes` and `links` files, not with `model` (the model file gives the patches)".to_string(),
+            ));
+        }
+        let full = paper_file("model", file)?;
+        let model = read_model(&full).map_err(|e| here(format!("`model` = {file:?}: {e}")))?;
+        if let Some((n, v)) = beyond_bound(&model.geometry.nodes) {
+            return Err(here(format!(
+                "`model` = {file:?}: node {} has the coordinate {v:e}, too large to square (lengths and contact forces would overflow): give coordinates in metres, within ±{MAX_LENGTH:e}",
+                n + 1
+            )));
+        }
+        // The model's own materials (INP sections), unless the scene names one for all.
+        let first_own = body.materials.len();
+        let own = spec.material.is_none() && !model.materials.is_empty();
+        if own {
+            for m in &model.materials {
+                if materials.iter().any(|o| o.name == m.name) {
+                    return Err(here(format!(
+                        "`model` = {file:?} defines material '{}', as does a [[materials]] entry: rename one, or give `material = ...` to use a scene material for every member",
+                        m.name
+                    )));
+                }
+                let material = Material::new(&m.name, m.youngs_modulus, m.area);
+                if let Some(p) = material.problem() {
+                    return Err(here(format!(
+                        "`model` = {file:?}: material '{}': {p}",
+                        m.name
+                    )));
+                }
+                body.materials.push(material);
+                notes.densities.push(m.density);
+            }
+        }
+        body.members.reserve_exact(model.geometry.members.len());
+        for (k, &nodes) in model.geometry.members.iter().enumerate() {
+            let material = match model.member_materials.get(k).copied().flatten() {
+                Some(i) if own => first_own + i,
+                _ => match default_material {
+                    Some(m) => m,
+                    None => {
+                        return Err(match &model.unassigned {
+                            Some(u) if own => here(format!("`model` = {file:?}: {u}")),
+                            _ => need_default(),
+                        })
+                    }
+                },
+            };
+            body.members.push(Member { nodes, material });
+        }
+        for s in &model.supports {
+            body.supports.push(Support {
+                node: s.node,
+                fixed: s.fixed,
+                displacement: s.displacement,
+                schedule: Schedule::Linear,
+            });
+        }
+        for &(node, force) in &model.loads {
+            body.loads.push(NodalLoad {
+                node,
+                force,
+                schedule: Schedule::Linear,
+            });
+        }
+        notes.found.extend(
+            model
+                .warnings
+                .iter()
+                .map(|w| format!("body '{}': `model`: {w}", spec.name)),
+        );
+        body.dimension = model.geometry.dimension;
+        body.nodes = model.geometry.nodes;
+        body.patches = model.geometry.patches;
+        groups = model.groups;
+    } else if from_files {
         let (Some(nodes_file), Some(links_file)) = (&spec.nodes, &spec.links) else {
             return Err(here(
                 "a body read from files needs both `nodes` and `links`".to_string(),
@@ -667,7 +759,7 @@ fn build_body(
         }
         let prepared = prepared_geometry(spec, folder).map_err(&here)?;
         let geometry: Geometry = if let Some(p) = prepared {
-            *report = Some(p.report);
+            notes.report = Some(p.report);
             Ok(p.geometry)
         } else if let Some(g) = &spec.disk {
             generators::disk(g.radius, g.rings, g.sectors)
@@ -740,8 +832,8 @@ fn build_body(
     for s in &spec.supports {
         let sp = s.get_ref();
         let fail = |m: String| at(s.span(), format!("body '{}': support: {m}", spec.name));
-        let nodes = select_nodes(&sp.selector(), &body).map_err(fail)?;
-        warnings.extend(
+        let nodes = select_nodes_in(&sp.selector(), &body, &groups).map_err(fail)?;
+        notes.warnings.extend(
             far_nearest_warning(&sp.selector(), &body, &nodes).map(|w| fail(w).to_string()),
         );
         if sp.fix.is_empty() {
@@ -787,8 +879,8 @@ fn build_body(
     for l in &spec.loads {
         let lp = l.get_ref();
         let fail = |m: String| at(l.span(), format!("body '{}': load: {m}", spec.name));
-        let nodes = select_nodes(&lp.selector(), &body).map_err(fail)?;
-        warnings.extend(
+        let nodes = select_nodes_in(&lp.selector(), &body, &groups).map_err(fail)?;
+        notes.warnings.extend(
             far_nearest_warning(&lp.selector(), &body, &nodes).map(|w| fail(w).to_string()),
         );
         let force = match (&lp.force, &lp.total_force) {
@@ -852,7 +944,7 @@ fn build_body(
             })
             .filter(|(_, f)| *f != nalgebra::Vector3::zeros())
             .collect();
-        warnings.extend(
+        notes.warnings.extend(
             partly_held_warning(key, force, nodes.len(), &lost, d).map(|w| fail(w).to_string()),
         );
         let schedule = schedule(&lp.schedule).map_err(fail)?;
@@ -867,7 +959,7 @@ fn build_body(
     for p in &spec.pressures {
         let fail = |m: String| at(p.span(), format!("body '{}': pressure: {m}", spec.name));
         let schedule = schedule(&p.get_ref().schedule).map_err(fail)?;
-        add_pressure(&mut body, p.get_ref(), schedule).map_err(fail)?;
+        add_pressure(&mut body, p.get_ref(), schedule, &groups).map_err(fail)?;
     }
     Ok(body)
 }

@@ -19,7 +19,7 @@ pub use self::results::{
 pub use self::run_error::RunError;
 pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS};
 pub use self::scene_digest::scene_digest;
-pub use self::selector::{far_nearest_warning, select_nodes, FAR_NEAREST};
+pub use self::selector::{far_nearest_warning, select_nodes, select_nodes_in, FAR_NEAREST};
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
 pub use self::strain_warning::LINEAR_STRAIN_WARNING;
@@ -37,6 +37,7 @@ mod check;
 mod contact_concentration;
 mod contact_pairs;
 mod driver;
+pub mod import;
 mod instability;
 mod link_lines;
 mod mesh_file;

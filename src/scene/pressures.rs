@@ -6,17 +6,19 @@ use crate::linkage::{
     boundary_segments, chosen_patches, pressure_loads_on, Body, Dimension, Kinematics, Pressure,
     PressureFaces, Schedule,
 };
-use crate::scene::select_nodes;
+use crate::scene::import::NodeGroup;
+use crate::scene::selector::select_nodes_in;
 use crate::scene::spec::PressureSpec;
 
 /// Add the pressure of `spec` (Pa on the chosen patches, N/m on the chosen 2D boundary
 /// segments) to `body`, growing by `schedule`: as nodal loads on the undeformed faces for a
-/// linear body, as a following [`Pressure`] for a body under large displacements. Errors say
-/// what to change.
+/// linear body, as a following [`Pressure`] for a body under large displacements; `groups`
+/// are the body's model-file groups (`group =`). Errors say what to change.
 pub(crate) fn add_pressure(
     body: &mut Body,
     spec: &PressureSpec,
     schedule: Schedule,
+    groups: &[NodeGroup],
 ) -> Result<(), String> {
     if !spec.pressure.is_finite() {
         return Err(format!(
@@ -24,7 +26,7 @@ pub(crate) fn add_pressure(
             spec.pressure
         ));
     }
-    let nodes = select_nodes(&spec.selector(), body)?;
+    let nodes = select_nodes_in(&spec.selector(), body, groups)?;
     let mut chosen = vec![false; body.nodes.len()];
     for n in nodes {
         chosen[n] = true;

@@ -1,6 +1,7 @@
 //! Choosing nodes of a body by number or by geometry.
 
 use crate::linkage::{Body, Dimension};
+use crate::scene::import::{find_group, NodeGroup};
 use crate::scene::spec::SelectorSpec;
 use crate::Real;
 use nalgebra::Vector3;
@@ -8,7 +9,18 @@ use nalgebra::Vector3;
 /// The nodes (0-based) a selector picks, or why it cannot pick any. Messages are for users:
 /// they say what was asked and what to change.
 pub fn select_nodes(spec: &SelectorSpec, body: &Body) -> Result<Vec<usize>, String> {
+    select_nodes_in(spec, body, &[])
+}
+
+/// [`select_nodes`] for a body read from a model file, whose named node `groups` the key
+/// `group` chooses from (exact name, else the one name that differs only in case).
+pub fn select_nodes_in(
+    spec: &SelectorSpec,
+    body: &Body,
+    groups: &[NodeGroup],
+) -> Result<Vec<usize>, String> {
     let given = [
+        spec.group.is_some(),
         spec.nodes.is_some(),
         spec.nearest.is_some(),
         spec.inside.is_some(),
@@ -20,8 +32,11 @@ pub fn select_nodes(spec: &SelectorSpec, body: &Body) -> Result<Vec<usize>, Stri
     .count();
     if given != 1 {
         return Err(format!(
-            "give exactly one of `nodes`, `nearest`, `inside`, `on_line`, `on_plane` to choose the nodes ({given} given)"
+            "give exactly one of `nodes`, `nearest`, `inside`, `on_line`, `on_plane`, `group` to choose the nodes ({given} given)"
         ));
+    }
+    if let Some(name) = &spec.group {
+        return group_nodes(name, body, groups);
     }
     let tolerance = match spec.tolerance {
         Some(t) if t.is_finite() && t >= 0.0 => t,
@@ -149,6 +164,33 @@ pub fn far_nearest_warning(spec: &SelectorSpec, body: &Body, picked: &[usize]) -
         &at.as_slice()[..d],
         extent(body)
     ))
+}
+
+/// The nodes of the group `name` among `groups` (a model file's).
+fn group_nodes(name: &str, body: &Body, groups: &[NodeGroup]) -> Result<Vec<usize>, String> {
+    if groups.is_empty() {
+        return Err(format!(
+            "`group` = {name:?}: body '{}' has no named groups; groups come from its `model` file (gmsh physical groups, INP *NSET and *ELSET)",
+            body.name
+        ));
+    }
+    let group = find_group(groups, name);
+    let names = groups
+        .iter()
+        .map(|g| format!("{:?}", g.name))
+        .collect::<Vec<_>>()
+        .join(", ");
+    match group {
+        None => Err(format!(
+            "`group` = {name:?} is not a group of body '{}': its model file has {names}",
+            body.name
+        )),
+        Some(g) if g.nodes.is_empty() => Err(format!(
+            "`group` = {name:?} holds no node of body '{}' (its elements are not part of the body)",
+            body.name
+        )),
+        Some(g) => Ok(g.nodes.clone()),
+    }
 }
 
 /// A point or direction with one component per dimension of the body, as a 3-vector.

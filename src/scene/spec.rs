@@ -227,6 +227,9 @@ pub struct BodySpec {
     pub mesh: Option<MeshSpec>,
     /// A 2D body triangulated inside an outline (constrained Delaunay, refined).
     pub outline: Option<OutlineSpec>,
+    /// A model file read as the body, relative to the scene file: a gmsh mesh (`.msh`, MSH
+    /// 4.1) or an Abaqus/CalculiX input file (`.inp`, with its materials, supports and loads).
+    pub model: Option<String>,
     /// Translation of the body's nodes (from files or a generator), m: places bodies in a scene.
     pub offset: Option<Vec<Real>>,
     /// Supports.
@@ -368,6 +371,9 @@ pub struct SelectorSpec {
     pub on_plane: Option<PlaneSpec>,
     /// Distance within which a node counts as on a line, plane or box, m (default 1e-6 of the body size).
     pub tolerance: Option<Real>,
+    /// The nodes of a named group of the body's model file (a gmsh physical group, an INP
+    /// `*NSET` or `*ELSET`).
+    pub group: Option<String>,
 }
 
 /// `inside = { min = [..], max = [..] }`, m.
@@ -416,6 +422,8 @@ pub struct SupportSpec {
     pub on_plane: Option<PlaneSpec>,
     /// See [`SelectorSpec`].
     pub tolerance: Option<Real>,
+    /// See [`SelectorSpec`].
+    pub group: Option<String>,
     /// Held directions: any of "x", "y", "z".
     pub fix: Vec<String>,
     /// Prescribed displacement at full schedule, m, one component per direction of the body;
@@ -441,6 +449,8 @@ pub struct LoadSpec {
     pub on_plane: Option<PlaneSpec>,
     /// See [`SelectorSpec`].
     pub tolerance: Option<Real>,
+    /// See [`SelectorSpec`].
+    pub group: Option<String>,
     /// Force per selected node at full schedule, N.
     pub force: Option<Vec<Real>>,
     /// Total force shared equally by the selected nodes at full schedule, N.
@@ -465,6 +475,8 @@ pub struct PressureSpec {
     pub on_plane: Option<PlaneSpec>,
     /// See [`SelectorSpec`].
     pub tolerance: Option<Real>,
+    /// See [`SelectorSpec`].
+    pub group: Option<String>,
     /// Pressure at full schedule, Pa (positive pushes into the body).
     pub pressure: Real,
     /// Factor per step 1..=steps (default: linear ramp).
@@ -522,11 +534,29 @@ macro_rules! selector_of {
                     on_line: self.on_line.clone(),
                     on_plane: self.on_plane.clone(),
                     tolerance: self.tolerance,
+                    ..SelectorSpec::default()
+                }
+            }
+        }
+    };
+    // An entry that may also choose a model file's `group`.
+    ($t:ty, group) => {
+        impl $t {
+            /// The selector keys of this entry.
+            pub fn selector(&self) -> SelectorSpec {
+                SelectorSpec {
+                    nodes: self.nodes.clone(),
+                    nearest: self.nearest.clone(),
+                    inside: self.inside.clone(),
+                    on_line: self.on_line.clone(),
+                    on_plane: self.on_plane.clone(),
+                    tolerance: self.tolerance,
+                    group: self.group.clone(),
                 }
             }
         }
     };
 }
-selector_of!(SupportSpec);
-selector_of!(LoadSpec);
-selector_of!(PressureSpec);
+selector_of!(SupportSpec, group);
+selector_of!(LoadSpec, group);
+selector_of!(PressureSpec, group);
