@@ -10,6 +10,7 @@ use crate::linkage::{
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::contact_pairs::friction_settings;
 use crate::scene::import::{read_model, NodeGroup};
+use crate::scene::inline_files::InlineFiles;
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::prepared_body::prepared_geometry;
@@ -126,6 +127,12 @@ pub fn load_scene(path: &Path) -> Result<World, SceneError> {
 /// Parse and check scene `text` that was read from `path` (relative file names resolve
 /// against its folder).
 pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
+    build_world_with(text, path, &InlineFiles::default())
+}
+
+/// [`build_world`], reading the paper's files (`nodes`, `links`, `patches`) held in `files`
+/// instead of the disk where `files` has their path (the Python package's bodies from arrays).
+pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<World, SceneError> {
     let started = std::time::Instant::now();
     let spec: SceneSpec = toml::from_str(text).map_err(|e| SceneError::Parse {
         path: path.to_path_buf(),
@@ -210,7 +217,14 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
     let mut found = Vec::new();
     for b in &spec.bodies {
         let mut notes = BodyNotes::default();
-        let body = build_body(b, &materials, (text, path), spec.steps, &at, &mut notes)?;
+        let body = build_body(
+            b,
+            &materials,
+            (text, path, files),
+            spec.steps,
+            &at,
+            &mut notes,
+        )?;
         if let Some(r) = notes.report {
             prepared.insert(body.name.clone(), r);
         }
@@ -513,7 +527,7 @@ struct BodyNotes {
 fn build_body(
     spanned: &Spanned<BodySpec>,
     materials: &[Material],
-    (text, scene): (&str, &Path),
+    (text, scene, files): (&str, &Path, &InlineFiles),
     steps: usize,
     at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
     notes: &mut BodyNotes,
@@ -530,7 +544,7 @@ fn build_body(
     // inside them with the scene line too.
     let paper_file = |key: &str, file: &str| -> Result<PathBuf, SceneError> {
         let full = folder.join(file);
-        if !full.is_file() {
+        if files.get(&full).is_none() && !full.is_file() {
             return Err(here(format!(
                 "`{key}` = {file:?}: there is no file {}: file names are relative to the folder of the scene file",
                 full.display()
@@ -716,7 +730,11 @@ fn build_body(
         };
         let nodes_path = paper_file("nodes", nodes_file)?;
         let links_path = paper_file("links", links_file)?;
-        let (dimension, nodes) = paper_files::read_nodes(&nodes_path).map_err(in_file("nodes"))?;
+        let (dimension, nodes) = match files.get(&nodes_path) {
+            Some(held) => paper_files::parse_nodes(held, &nodes_path),
+            None => paper_files::read_nodes(&nodes_path),
+        }
+        .map_err(in_file("nodes"))?;
         // Lengths square coordinate differences: past about 1e154 they overflow.
         if let Some((n, v)) = beyond_bound(&nodes) {
             return Err(here(format!(
@@ -724,7 +742,11 @@ fn build_body(
                 n + 1
             )));
         }
-        let links = paper_files::read_links(&links_path, &nodes).map_err(in_file("links"))?;
+        let links = match files.get(&links_path) {
+            Some(held) => paper_files::parse_links(held, &links_path, &nodes),
+            None => paper_files::read_links(&links_path, &nodes),
+        }
+        .map_err(in_file("links"))?;
         body.members.reserve_exact(links.len());
         for link in &links {
             let material = match &link.material {
@@ -745,9 +767,12 @@ fn build_body(
             });
         }
         if let Some(patches_file) = &spec.patches {
-            body.patches =
-                paper_files::read_patches(&paper_file("patches", patches_file)?, nodes.len())
-                    .map_err(in_file("patches"))?;
+            let patches_path = paper_file("patches", patches_file)?;
+            body.patches = match files.get(&patches_path) {
+                Some(held) => paper_files::parse_patches(held, &patches_path, nodes.len()),
+                None => paper_files::read_patches(&patches_path, nodes.len()),
+            }
+            .map_err(in_file("patches"))?;
         }
         body.dimension = dimension;
         body.nodes = nodes;

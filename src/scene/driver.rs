@@ -4,7 +4,7 @@
 use crate::scene::check::output_warning;
 use crate::scene::peak_stress::peak_stress;
 use crate::scene::publish::{destination, publish, remove_stale, staging_dir};
-use crate::scene::results::{PhaseSeconds, Summary, SummaryBreak};
+use crate::scene::results::{PhaseSeconds, StepResult, Summary, SummaryBreak};
 use crate::scene::run_error::RunError;
 use crate::scene::run_results::step_digits;
 use crate::scene::simulation::Simulation;
@@ -95,83 +95,25 @@ fn run_in(
         let setup = started.elapsed().as_secs_f64();
         // Not before the set-up: that is where the run's memory peaks.
         let model_file = scope.spawn(|| write_model(world, staging));
-        let mut summary = Summary {
-            scene: world.name.clone(),
-            steps: Vec::with_capacity(world.steps + 1),
-            bodies: simulation.sizes(),
-            phases: PhaseSeconds {
-                reading: world.build_seconds,
-                ..Default::default()
-            },
-            failure: None,
-            scene_digest: world.scene_digest.clone(),
-            prepared: world.prepared.clone(),
-            breaks: Vec::new(),
-            collapse: None,
-        };
+        let mut summary = start_summary(world, &simulation);
         // The stored steps stay in memory only for the writers after the loop that need them.
         let keep = keeps_steps(world, draw);
         // Every file name of the run has enough digits for its last step, so they sort.
         let digits = step_digits(world.steps);
         let writer = StepWriter::start(scope, world, &steps_dir, digits, keep);
-        let mut stopped = None;
-        for step in 0..=world.steps {
-            if stop.load(Ordering::Relaxed) {
-                return Err(RunError::Interrupted {
-                    scene: world.source.clone(),
-                    step,
-                });
-            }
-            let t = Instant::now();
-            let (result, mut line) = match simulation.step(step) {
-                Ok(solved) => solved,
-                // A collapse is a result: the summary records it and the run ends there, published
-                // as a complete run.
-                Err(RunError::Collapse { collapse, breaks }) if step > 0 => {
-                    summary.breaks.extend(breaks);
-                    summary.collapse = Some(collapse);
-                    break;
-                }
-                // A step after step 0 that cannot be solved ends the run, but the steps before it
-                // are kept and the summary says why it stopped.
-                Err(e) if step > 0 => {
-                    summary.failure = Some(failure_text(&e));
-                    stopped = Some(e);
-                    break;
-                }
-                Err(e) => return Err(e),
-            };
-            line.seconds = t.elapsed().as_secs_f64() + if step == 1 { setup } else { 0.0 };
-            for b in &result.bodies {
-                let Some(f) = &b.fracture else { continue };
-                summary.breaks.extend(f.breaks.iter().map(|r| SummaryBreak {
-                    step,
-                    body: b.name.clone(),
-                    member: r.member,
-                    load_factor: r.load_factor,
-                    tooth: r.tooth,
-                }));
-            }
-            if step == 0 {
-                line.warnings.extend(world.warnings.iter().cloned());
-                line.warnings.extend(output_warning(world));
-            }
-            (line.peak_stress, line.stress_ratio) = peak_stress(&result, Some(world));
-            summary.steps.push(line);
-            // A writer stopped by an error: finish returns it below.
-            if world.output.writes(step, world.steps) && !writer.write(result) {
-                break;
-            }
-            on_step();
-        }
-        let (kept, writing) = writer.finish()?;
+        let stepped = solve_steps(
+            &mut simulation,
+            &mut summary,
+            setup,
+            on_step,
+            stop,
+            &mut |result| writer.write(result),
+        );
+        let finished = writer.finish();
+        let stopped = stepped?;
+        let (kept, writing) = finished?;
         summary.phases.writing += writing;
-        let (times, query) = simulation.times();
-        summary.phases.assembly += times.assembly;
-        summary.phases.symbolic += times.symbolic;
-        summary.phases.numeric += times.numeric;
-        summary.phases.solve += times.solve;
-        summary.phases.contact_query += query;
+        add_solver_times(&mut summary, &simulation);
         let (model, model_seconds) = model_file
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
@@ -188,6 +130,129 @@ fn run_in(
             None => Ok(summary),
         }
     })
+}
+
+/// Solve `world` in memory: the summary and the steps its `[output]` stores (step 0, every
+/// k-th, the last), as [`run_until`] would write them, with nothing written. A step after step
+/// 0 that cannot be solved ends the run as it does there: the summary's `failure` says why and
+/// the error comes back beside the steps solved before it.
+pub fn run_in_memory(
+    world: &World,
+    on_step: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Result<(Summary, Vec<StepResult>, Option<RunError>), RunError> {
+    let started = Instant::now();
+    let mut simulation = Simulation::new(world)?;
+    let setup = started.elapsed().as_secs_f64();
+    let mut summary = start_summary(world, &simulation);
+    let mut steps = Vec::new();
+    let stopped = solve_steps(
+        &mut simulation,
+        &mut summary,
+        setup,
+        on_step,
+        stop,
+        &mut |result| {
+            steps.push(result);
+            true
+        },
+    )?;
+    add_solver_times(&mut summary, &simulation);
+    Ok((summary, steps, stopped))
+}
+
+/// The summary of a run about to be solved with `simulation`: no steps yet.
+fn start_summary(world: &World, simulation: &Simulation) -> Summary {
+    Summary {
+        scene: world.name.clone(),
+        steps: Vec::with_capacity(world.steps + 1),
+        bodies: simulation.sizes(),
+        phases: PhaseSeconds {
+            reading: world.build_seconds,
+            ..Default::default()
+        },
+        failure: None,
+        scene_digest: world.scene_digest.clone(),
+        prepared: world.prepared.clone(),
+        breaks: Vec::new(),
+        collapse: None,
+    }
+}
+
+/// Add the solvers' time (assembly, factorizations, solves, contact queries) to the summary.
+fn add_solver_times(summary: &mut Summary, simulation: &Simulation) {
+    let (times, query) = simulation.times();
+    summary.phases.assembly += times.assembly;
+    summary.phases.symbolic += times.symbolic;
+    summary.phases.numeric += times.numeric;
+    summary.phases.solve += times.solve;
+    summary.phases.contact_query += query;
+}
+
+/// Solve steps 0..=steps of the simulation's world in order, each one's line into `summary`
+/// (`setup` s counted in step 1's time), handing the steps the world's `[output]` writes to
+/// `store` (which answers false to stop: its writer failed) and calling `on_step` after each.
+/// Stops before a step once `stop` is set ([`RunError::Interrupted`]). A collapse ends the run
+/// as a result; a step after step 0 that cannot be solved ends it with the summary's `failure`
+/// set and the error returned as `Ok(Some(..))`; step 0's error is returned as `Err`.
+fn solve_steps(
+    simulation: &mut Simulation,
+    summary: &mut Summary,
+    setup: f64,
+    on_step: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+    store: &mut dyn FnMut(StepResult) -> bool,
+) -> Result<Option<RunError>, RunError> {
+    let world = simulation.world;
+    for step in 0..=world.steps {
+        if stop.load(Ordering::Relaxed) {
+            return Err(RunError::Interrupted {
+                scene: world.source.clone(),
+                step,
+            });
+        }
+        let t = Instant::now();
+        let (result, mut line) = match simulation.step(step) {
+            Ok(solved) => solved,
+            // A collapse is a result: the summary records it and the run ends there, published
+            // as a complete run.
+            Err(RunError::Collapse { collapse, breaks }) if step > 0 => {
+                summary.breaks.extend(breaks);
+                summary.collapse = Some(collapse);
+                break;
+            }
+            // A step after step 0 that cannot be solved ends the run, but the steps before it
+            // are kept and the summary says why it stopped.
+            Err(e) if step > 0 => {
+                summary.failure = Some(failure_text(&e));
+                return Ok(Some(e));
+            }
+            Err(e) => return Err(e),
+        };
+        line.seconds = t.elapsed().as_secs_f64() + if step == 1 { setup } else { 0.0 };
+        for b in &result.bodies {
+            let Some(f) = &b.fracture else { continue };
+            summary.breaks.extend(f.breaks.iter().map(|r| SummaryBreak {
+                step,
+                body: b.name.clone(),
+                member: r.member,
+                load_factor: r.load_factor,
+                tooth: r.tooth,
+            }));
+        }
+        if step == 0 {
+            line.warnings.extend(world.warnings.iter().cloned());
+            line.warnings.extend(output_warning(world));
+        }
+        (line.peak_stress, line.stress_ratio) = peak_stress(&result, Some(world));
+        summary.steps.push(line);
+        // A writer stopped by an error: its finish returns the error.
+        if world.output.writes(step, world.steps) && !store(result) {
+            break;
+        }
+        on_step();
+    }
+    Ok(None)
 }
 
 /// The summary's `failure`: why the step failed, without the scene file the error names.

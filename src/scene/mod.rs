@@ -1,12 +1,13 @@
 //! Scene files, the load-step driver and the result files.
 
-pub use self::build::{build_world, load_scene, SceneError};
+pub use self::build::{build_world, build_world_with, load_scene, SceneError};
 pub use self::check::{
     check_world, obstacle_offset_bytes, output_warning, step_file_bytes, stored_steps, CheckReport,
     BYTES_PER_VALUE, NPZ_BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
 };
 pub use self::contact_concentration::{CONCENTRATED_SHARE, NEIGHBOUR_SLOPE};
-pub use self::driver::{run, run_into, run_until, run_with};
+pub use self::driver::{run, run_in_memory, run_into, run_until, run_with};
+pub use self::inline_files::InlineFiles;
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::plot_settings::{PlotNode, PlotSettings};
@@ -23,7 +24,7 @@ pub use self::selector::{far_nearest_warning, select_nodes, select_nodes_in, FAR
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
 pub use self::strain_warning::LINEAR_STRAIN_WARNING;
-pub use self::sweep::{expand_sweep, SweepMode, Variant};
+pub use self::sweep::{expand_sweep, with_values, SweepMode, Variant};
 pub use self::vtk::{write_vtk, VtkError};
 pub use self::vtu_arrays::VtkEncoding;
 pub use self::world::{OutputSettings, World};
@@ -38,6 +39,7 @@ mod contact_concentration;
 mod contact_pairs;
 mod driver;
 pub mod import;
+mod inline_files;
 mod instability;
 mod link_lines;
 mod mesh_file;

@@ -237,6 +237,11 @@ pub fn write_nodes(
     dimension: Dimension,
     nodes: &[Vector3<Real>],
 ) -> std::io::Result<()> {
+    write_atomically(path, nodes_text(dimension, nodes)?.as_bytes())
+}
+
+/// The text [`write_nodes`] writes: [`parse_nodes`] reads `nodes` back from it exactly.
+pub fn nodes_text(dimension: Dimension, nodes: &[Vector3<Real>]) -> std::io::Result<String> {
     let d = dimension.dofs_per_node();
     let mut text = String::with_capacity(nodes.len() * 16 * d);
     for (n, p) in nodes.iter().enumerate() {
@@ -259,7 +264,7 @@ pub fn write_nodes(
             Dimension::Three => writeln!(text, "{:?} {:?} {:?}", p.x, p.y, p.z),
         };
     }
-    write_atomically(path, text.as_bytes())
+    Ok(text)
 }
 
 /// Write a links file atomically: `i j` per member (1-based node numbers), or `i j material`
@@ -271,6 +276,11 @@ pub fn write_links(
     members: &[[usize; 2]],
     materials: Option<&[String]>,
 ) -> std::io::Result<()> {
+    write_atomically(path, links_text(members, materials)?.as_bytes())
+}
+
+/// The text [`write_links`] writes (`members` 0-based; written 1-based).
+pub fn links_text(members: &[[usize; 2]], materials: Option<&[String]>) -> std::io::Result<String> {
     if let Some(names) = materials {
         if names.len() != members.len() {
             return Err(invalid_input(format!(
@@ -296,7 +306,7 @@ pub fn write_links(
             None => writeln!(text, "{} {}", a + 1, b + 1),
         };
     }
-    write_atomically(path, text.as_bytes())
+    Ok(text)
 }
 
 /// Write a patches file atomically: `i j k` per patch, 1-based node numbers, in the order given

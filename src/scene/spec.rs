@@ -1,11 +1,12 @@
 //! The scene file as written (TOML), before any checking beyond types: see `docs/SCENES.md`.
+//! The types also serialize (the Python package's `Scene.to_dict`), leaving out absent keys.
 
 use crate::Real;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use toml::Spanned;
 
 /// A whole scene file. Unknown keys are errors.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSpec {
     /// Names the output folder `DIR/<name>/`.
@@ -40,7 +41,7 @@ pub struct SceneSpec {
 }
 
 /// `[contact]`: penalty and tolerances (see `docs/SCENES.md`).
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
     /// Penalty stiffness, N/m of penetration (default: 100 × the mean E A / L of the body).
@@ -65,7 +66,7 @@ pub struct ContactSpec {
 }
 
 /// `[[contact.pairs]]`: friction between two named bodies or obstacles.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactPairSpec {
     /// The two names: bodies or obstacles.
@@ -77,7 +78,7 @@ pub struct ContactPairSpec {
 }
 
 /// `[[obstacles]]`: a rigid obstacle (see `docs/SCENES.md`).
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObstacleSpec {
     /// Name, distinct from every body's and obstacle's name.
@@ -144,7 +145,7 @@ fn number_or_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Vec<R
 }
 
 /// `[[materials]]`: E, A and optional strengths.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
     /// Name referred to by bodies and links files.
@@ -172,7 +173,7 @@ pub struct MaterialSpec {
 }
 
 /// `softening = { fracture_energy = 100.0, teeth = 5 }` of a breaking material.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SofteningSpec {
     /// Fracture energy G_f, J/m² over the member's cross-section.
@@ -182,7 +183,7 @@ pub struct SofteningSpec {
 }
 
 /// `scatter = { weibull_modulus = 12.0, seed = 7 }` of a breaking material.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ScatterSpec {
     /// Weibull modulus (shape), > 0.
@@ -192,7 +193,7 @@ pub struct ScatterSpec {
 }
 
 /// `[[bodies]]`: where the geometry comes from, its material, supports and loads.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
     /// Unique name in the scene.
@@ -244,7 +245,7 @@ pub struct BodySpec {
 }
 
 /// `[bodies.newton]`: convergence settings of the Newton solve (see `docs/SCENES.md`).
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct NewtonSpec {
     /// Relative out-of-balance force at convergence (default 1e-8).
@@ -258,7 +259,7 @@ pub struct NewtonSpec {
 }
 
 /// `[bodies.iterative]`: when conjugate gradients stop (see `docs/SCENES.md`).
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct IterativeSpec {
     /// Relative residual at which a solve stops (default 1e-10).
@@ -270,7 +271,7 @@ pub struct IterativeSpec {
 }
 
 /// `[bodies.path]`: `method = "schedules"` (default) or `"arc_length"` with `arc_length` (m).
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PathSpec {
     /// `"schedules"` or `"arc_length"`.
@@ -280,7 +281,7 @@ pub struct PathSpec {
 }
 
 /// `disk = { radius, rings, sectors }`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DiskSpec {
     /// Radius, m.
@@ -298,7 +299,7 @@ fn eight() -> usize {
 }
 
 /// `rectangle = { width, height, cells = [nx, ny] }`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RectangleSpec {
     /// Extent in x, m.
@@ -310,7 +311,7 @@ pub struct RectangleSpec {
 }
 
 /// `cylindrical_shell = { radius, length, rings, sectors }`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShellSpec {
     /// Radius, m.
@@ -324,7 +325,7 @@ pub struct ShellSpec {
 }
 
 /// `box_lattice = { size = [x, y, z], cells = [nx, ny, nz] }`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LatticeSpec {
     /// Extent, m.
@@ -334,7 +335,7 @@ pub struct LatticeSpec {
 }
 
 /// `mesh = { file, spacing }`: a closed OBJ or STL mesh (m) filled with members.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
     /// The mesh file, relative to the scene file.
@@ -344,7 +345,7 @@ pub struct MeshSpec {
 }
 
 /// `outline = { file | points, spacing }`: a 2D polygon with holes (m).
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutlineSpec {
     /// A file of loops (one `x y` per line, a blank line between loops), relative to the scene.
@@ -356,7 +357,7 @@ pub struct OutlineSpec {
 }
 
 /// Which nodes a support or load applies to: exactly one of the selector keys.
-#[derive(Debug, Deserialize, Default)]
+#[derive(Debug, Deserialize, Serialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct SelectorSpec {
     /// 1-based node numbers.
@@ -377,7 +378,7 @@ pub struct SelectorSpec {
 }
 
 /// `inside = { min = [..], max = [..] }`, m.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoxSpec {
     /// Lower corner, m.
@@ -387,7 +388,7 @@ pub struct BoxSpec {
 }
 
 /// `on_line = { point = [..], direction = [..] }`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LineSpec {
     /// A point of the line, m.
@@ -397,7 +398,7 @@ pub struct LineSpec {
 }
 
 /// `on_plane = { point = [..], normal = [..] }`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlaneSpec {
     /// A point of the plane, m.
@@ -407,7 +408,7 @@ pub struct PlaneSpec {
 }
 
 /// `[[bodies.supports]]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SupportSpec {
     /// 1-based node numbers.
@@ -434,7 +435,7 @@ pub struct SupportSpec {
 }
 
 /// `[[bodies.loads]]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSpec {
     /// 1-based node numbers.
@@ -460,7 +461,7 @@ pub struct LoadSpec {
 }
 
 /// `[[bodies.pressures]]`: a pressure on every patch whose three nodes the selector chooses.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PressureSpec {
     /// 1-based node numbers.
@@ -484,7 +485,7 @@ pub struct PressureSpec {
 }
 
 /// `[output]`: which steps are written, pictures and VTK files.
-#[derive(Debug, Deserialize, Default)]
+#[derive(Debug, Deserialize, Serialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// Write every k-th step (step 0 and the last are always written); default 1.

@@ -134,6 +134,46 @@ pub fn expand_sweep(text: &str, path: &Path) -> Result<Vec<Variant>, SceneError>
     Ok(variants)
 }
 
+/// Scene `text` (read from `path`) with each dotted key of `values` set to its value: the
+/// variant a `[sweep]` giving each of these keys this one value makes (the same text, with
+/// `[sweep]` removed), checked as a sweep is: every key must name a value written in the scene,
+/// and every value must have that value's type. The Python package's `Scene.load(values=)`.
+pub fn with_values(
+    text: &str,
+    path: &Path,
+    values: &[(String, Value)],
+) -> Result<Variant, SceneError> {
+    let mut table: Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| SceneError::Parse {
+            path: path.to_path_buf(),
+            message: e.to_string().trim_end().to_string(),
+        })?;
+    table.remove("sweep");
+    let fail = |key: &str, message: String| SceneError::Parse {
+        path: path.to_path_buf(),
+        message: format!("values: `{key}`: {message}"),
+    };
+    for (key, value) in values {
+        let current = find(&table, key).map_err(|e| fail(key, e))?;
+        if let Some(problem) = type_mismatch(current, value) {
+            return Err(fail(
+                key,
+                format!("{value}: {problem} (the scene has {current})"),
+            ));
+        }
+        *find_mut(&mut table, key).map_err(|e| fail(key, e))? = value.clone();
+    }
+    let text = toml::to_string(&table).map_err(|e| SceneError::Parse {
+        path: path.to_path_buf(),
+        message: format!("values: cannot write the scene as TOML: {e}"),
+    })?;
+    Ok(Variant {
+        values: values.to_vec(),
+        text,
+    })
+}
+
 /// Every combination of one value per key, the last key fastest.
 fn grid(keys: &[(String, Vec<Value>)]) -> Vec<Vec<usize>> {
     let mut out = vec![Vec::new()];
@@ -338,6 +378,38 @@ force = [1.0, 2.0]
 "bodies.beam.loads.1.force.2" = [5, 6.5]
 "materials.steel.youngs_modulus" = [1e9]
 "#;
+
+    #[test]
+    fn values_give_the_text_of_the_sweep_variant_with_those_values() {
+        let variants = expand_sweep(SCENE, Path::new("s.toml")).unwrap();
+        let values = vec![
+            ("bodies.beam.loads.1.force.2".to_string(), Value::Float(6.5)),
+            (
+                "materials.steel.youngs_modulus".to_string(),
+                Value::Float(1e9),
+            ),
+        ];
+        let set = with_values(SCENE, Path::new("s.toml"), &values).unwrap();
+        assert_eq!(set.text, variants[1].text);
+        assert_eq!(set.values, values);
+        let wrong = [(
+            "materials.steel.youngs_modulus".to_string(),
+            Value::String("x".into()),
+        )];
+        let e = with_values(SCENE, Path::new("s.toml"), &wrong)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("s.toml: values: `materials.steel.youngs_modulus`"),
+            "{e}"
+        );
+        assert!(e.contains("a string cannot replace a float"), "{e}");
+        let missing = [("materials.alu.area".to_string(), Value::Float(1.0))];
+        let e = with_values(SCENE, Path::new("s.toml"), &missing)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no entry named 'alu'"), "{e}");
+    }
 
     #[test]
     fn paths_walk_names_positions_and_list_elements() {
