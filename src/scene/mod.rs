@@ -31,6 +31,7 @@ pub mod atomic_file;
 pub mod batch;
 mod bounds;
 mod build;
+mod capacity;
 mod check;
 mod contact_pairs;
 mod driver;
