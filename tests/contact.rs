@@ -1257,3 +1257,42 @@ normal = [0.0, 1.0]
         "{error}"
     );
 }
+
+/// Gravity with contact (a pair of the table in docs/SCENES.md): the bar above standing on
+/// the floor, loaded by nothing but its own weight (ρ = 7850 kg/m³, g = 9.81 m/s², W = ρ A L g
+/// lumped half to each end) and the top node's held sideways only: the floor pushes back with
+/// the whole weight W, its foot sinks W/k (k the penalty), and the bar carries −W/2 (its top
+/// node's half of the weight), to 1e-9, at both steps (W/2, then W).
+#[test]
+fn a_bar_standing_on_the_floor_under_its_own_weight() {
+    let scene = bar_on_floor("[contact]\npenalty = 1e6\n")
+        .replace(
+            "[[bodies.loads]]\nnodes = [2]\nforce = [0.0, -1000.0]\n",
+            "",
+        )
+        .replace("steps = 2\n", "steps = 2\ngravity = [0.0, -9.81]\n")
+        .replace("area = 1e-4\n", "area = 1e-4\ndensity = 7850\n");
+    let (_dir, path) = scene_with(
+        &[("bar.nodes", BAR_NODES), ("bar.links", BAR_LINKS)],
+        &scene,
+    );
+    let world = load_scene(&path).unwrap();
+    let k = 1e6;
+    for (result, _) in run_all(&world).into_iter().skip(1) {
+        let w = 7850.0 * 1e-4 * 1.0 * 9.81 * result.load_factor;
+        let bar = &result.bodies[0];
+        assert_eq!(bar.contacts.len(), 1, "{:?}", bar.contacts);
+        let c = &bar.contacts[0];
+        assert!(
+            (c.force[1] - w).abs() <= 1e-9 * w,
+            "{} against {w}",
+            c.force[1]
+        );
+        assert!((c.depth - w / k).abs() <= 1e-9 * w / k, "{}", c.depth);
+        assert!(
+            (bar.axial_forces[0] + w / 2.0).abs() <= 1e-9 * w,
+            "{}",
+            bar.axial_forces[0]
+        );
+    }
+}

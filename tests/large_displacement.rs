@@ -838,3 +838,94 @@ fn buckled_column_under_load_control_warns_of_negative_pivots() {
         );
     }
 }
+
+/// Case 8 of issue 32, **a snap-through passed in silence**: the von Mises truss under load
+/// control to twice its limit load (0.999 of it: step 5 just short of the limit point) in 10
+/// steps. Step 5 ends near the limit point (apex 0.041 m down), step 6 on the far branch (0.218 m: 8.8 times the step before's change, below the
+/// jump ratio of 10), every solved state stable (0 negative pivots). The tangent between the
+/// two states has a negative pivot: step 6 warns that a limit point was passed within it, and
+/// no other step warns. Step 6's state is the closed form's far-branch equilibrium at 1.2
+/// times the limit load (to 1e-6 of the load).
+#[test]
+fn a_snap_through_passed_in_silence() {
+    let dir = tempfile::tempdir().unwrap();
+    // Twice 0.999 of the closed-form limit load (7622 N rounds it up: step 5 would be past it).
+    let (w_limit, p_limit) = von_mises_limit();
+    let factor = 2.0 * 0.999 * p_limit / 7622.0;
+    let scene = von_mises_scene(dir.path(), 10, factor, None, "");
+    let world = linkage::scene::load_scene(&scene).unwrap();
+    let mut sim = linkage::scene::Simulation::new(&world).unwrap();
+    let mut warnings = Vec::new();
+    let mut apex = Vec::new();
+    for step in 0..=world.steps {
+        let (result, summary) = sim.step(step).unwrap();
+        assert_eq!(summary.negative_pivots, 0, "step {step}");
+        apex.push(-result.bodies[0].displacements[1][1]);
+        warnings.extend(summary.warnings.into_iter().map(|w| (step, w)));
+    }
+    // Step 5 just short of the limit point (apex 0.042 m down), step 6 on the far branch.
+    assert!(apex[5] < w_limit && apex[5] > 0.038, "{apex:?}");
+    assert!((apex[6] - 0.218).abs() < 2e-3, "{apex:?}");
+    // Step 6 of 10: 0.6 of the full load, 1.2 times 0.999 of the limit load.
+    let p6 = 0.6 * factor * 7622.0;
+    assert!(
+        (von_mises_load(apex[6]) - p6).abs() < 1e-6 * p6,
+        "{} against {p6}",
+        von_mises_load(apex[6])
+    );
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    let (step, w) = &warnings[0];
+    assert_eq!(*step, 6);
+    for part in [
+        "step 6: body 'truss': a limit point was passed within the step",
+        "negative pivot",
+        "[bodies.path] method = \"arc_length\"",
+    ] {
+        assert!(w.contains(part), "{part:?} in {w}");
+    }
+}
+
+/// Gravity with large displacements (a pair of the table in docs/SCENES.md): a V of two bars
+/// (nodes (−1, 1) and (1, 1) held, (0, 0) free, E A = 2e7 N, ρ = 7850 kg/m³) under its own
+/// weight alone, about 31 N: the large-kinematics body and the linear one agree to 1e-5 of
+/// the displacement (the difference is of the order of the strain, 1e-6), and both carry the
+/// closed form N = (W/2)/(2 cos 45°) = W/(2√2) per bar (the free node's half of the two bars'
+/// weight W), to 1e-5.
+#[test]
+fn a_large_body_under_its_own_weight_agrees_with_the_linear_one() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("v.nodes"), "-1 1\n1 1\n0 0\n").unwrap();
+    std::fs::write(dir.path().join("v.links"), "1 3\n2 3\n").unwrap();
+    let mut answers = Vec::new();
+    for kinematics in ["linear", "large"] {
+        let scene = dir.path().join(format!("{kinematics}.toml"));
+        std::fs::write(
+            &scene,
+            format!(
+                "name = \"v\"\nsteps = 1\ngravity = [0.0, -9.81]\n[[materials]]\nname = \"steel\"\nyoungs_modulus = 200e9\narea = 1e-4\ndensity = 7850\n\
+                 [[bodies]]\nname = \"v\"\nnodes = \"v.nodes\"\nlinks = \"v.links\"\nkinematics = \"{kinematics}\"\n\
+                 [[bodies.supports]]\nnodes = [1, 2]\nfix = [\"x\", \"y\"]\n"
+            ),
+        )
+        .unwrap();
+        let world = linkage::scene::load_scene(&scene).unwrap();
+        let mut sim = linkage::scene::Simulation::new(&world).unwrap();
+        sim.step(0).unwrap();
+        let (result, _) = sim.step(1).unwrap();
+        let body = &result.bodies[0];
+        answers.push((body.displacements[2][1], body.axial_forces.clone()));
+    }
+    let weight = 2.0 * 7850.0 * 1e-4 * 2f64.sqrt() * 9.81;
+    let n = weight / 2.0 / 2f64.sqrt();
+    let (linear, large) = (&answers[0], &answers[1]);
+    assert!(linear.0 < 0.0);
+    assert!(
+        (large.0 - linear.0).abs() <= 1e-5 * linear.0.abs(),
+        "{answers:?}"
+    );
+    for forces in [&linear.1, &large.1] {
+        for f in forces {
+            assert!((f - n).abs() <= 1e-5 * n, "{f} against {n}");
+        }
+    }
+}

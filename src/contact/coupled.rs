@@ -29,6 +29,9 @@ pub(crate) struct CoupledSolver {
     pub(crate) negative_pivots: usize,
     /// Conjugate gradients, when a body is solved iteratively.
     iterative: Option<CoupledIterative>,
+    /// Whether conjugate gradients could not serve an iteration and the coupled matrix was
+    /// factored directly instead (the iterative bodies are then "iterative, then direct").
+    fell_back: bool,
     /// The unsymmetric part of slipping contacts' tangents, `Σ u vᵀ` over global free DOFs,
     /// as filled with the tangent (solved by [`LowRankCorrection`] on the symmetric factor).
     rank_one: Vec<(SparseColumn, SparseColumn)>,
@@ -62,6 +65,7 @@ impl CoupledSolver {
             unheld: 0,
             negative_pivots: 0,
             iterative,
+            fell_back: false,
             rank_one: Vec::new(),
             correction: None,
         })
@@ -105,7 +109,13 @@ impl CoupledSolver {
     /// The linear solver body `b`'s rows get.
     pub(crate) fn solver_used(&self, b: usize) -> SolverUsed {
         match &self.iterative {
-            Some(i) if i.iterative.get(b).copied().unwrap_or(false) => SolverUsed::Iterative,
+            Some(i) if i.iterative.get(b).copied().unwrap_or(false) => {
+                if self.fell_back {
+                    SolverUsed::IterativeThenDirect
+                } else {
+                    SolverUsed::Iterative
+                }
+            }
             _ => SolverUsed::Direct,
         }
     }
@@ -201,6 +211,7 @@ impl CoupledSolver {
                     }
                     None => {
                         // Direct (conjugate gradients could not serve: a singular block).
+                        self.fell_back |= self.iterative.is_some();
                         let stabilised = self.factorize_filled(p, times)?;
                         self.factored = (!stabilised).then(|| p.set.clone());
                         let t = Instant::now();

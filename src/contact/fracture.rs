@@ -236,6 +236,28 @@ impl ContactFracture {
         best
     }
 
+    /// The members of `over` (per body) other than member `m` of body `b` that are at their
+    /// strength in `stress` (to [`AT_STRENGTH`]) as it is: they tie with it (by body, then
+    /// member).
+    fn tied(
+        &self,
+        b: usize,
+        m: usize,
+        stress: &[Vec<Real>],
+        over: &[Vec<bool>],
+    ) -> Vec<(usize, usize)> {
+        let mut tied = Vec::new();
+        for (c, br) in self.breaking.iter().enumerate() {
+            let Some(br) = br else { continue };
+            for (j, (&factor, &beyond)) in br.factor.iter().zip(&over[c]).enumerate() {
+                if (c, j) != (b, m) && factor > 0.0 && beyond && self.at_strength(c, j, stress) {
+                    tied.push((c, j));
+                }
+            }
+        }
+        tied
+    }
+
     /// Whether member `m` of body `b` is at its strength (tensile or compressive) in `stress`
     /// to [`AT_STRENGTH`].
     fn at_strength(&self, b: usize, m: usize, stress: &[Vec<Real>]) -> bool {
@@ -354,12 +376,18 @@ impl ContactFracture {
                 else {
                     break;
                 };
-                let tooth = self.break_member(b, m);
-                events[b].push(BreakEvent {
-                    member: m,
-                    fraction: t_break - (end - 1.0),
-                    tooth,
-                });
+                // Members at their strength at the same load (symmetric twins) break with it,
+                // in one event, as without contact.
+                let at_break = self.stresses(solver);
+                let tied = self.tied(b, m, &at_break, &over);
+                for (b, m) in std::iter::once((b, m)).chain(tied) {
+                    let tooth = self.break_member(b, m);
+                    events[b].push(BreakEvent {
+                        member: m,
+                        fraction: t_break - (end - 1.0),
+                        tooth,
+                    });
+                }
                 // The state just after the break, at its load, then at the step's.
                 let mut after = Vec::new();
                 for t in [t_break, end] {
@@ -454,7 +482,7 @@ impl ContactFracture {
         solver.restore(saved);
         self.now = from;
         let pieces = self.loose_pieces(solver, b);
-        if pieces.is_empty() {
+        if pieces.is_empty() || self.is_collapse(b, &pieces, obstacles) {
             return Ok(false);
         }
         for nodes in &pieces {
@@ -517,6 +545,48 @@ impl ContactFracture {
         .into_iter()
         .filter(|piece| !piece.iter().any(|&n| touching[n]))
         .collect()
+    }
+
+    /// Whether the loose `pieces` of body `b` are its collapse rather than pieces falling off
+    /// (as [`BreakingEquilibrium`](crate::linkage::fracture::BreakingEquilibrium) decides
+    /// without contact): a loaded piece still hanging on the rest by intact members (a
+    /// mechanism under load), or a loss after which nothing drives the rest (no load left on
+    /// it, no support and no obstacle that moves).
+    fn is_collapse(&self, b: usize, pieces: &[Vec<usize>], obstacles: &[Obstacle]) -> bool {
+        let body = &self.bodies[b];
+        let mut released = self.fallen[b].clone();
+        for &n in pieces.iter().flatten() {
+            released[n] = true;
+        }
+        let loaded = |n: usize| {
+            body.loads
+                .iter()
+                .any(|l| l.node == n && l.force != Vector3::zeros())
+        };
+        let hanging = |piece: &[usize]| {
+            body.members.iter().enumerate().any(|(j, member)| {
+                let [a, c] = member.nodes;
+                body.modulus_factor(j) > 0.0
+                    && (piece.binary_search(&a).is_ok() && !released[c]
+                        || piece.binary_search(&c).is_ok() && !released[a])
+            })
+        };
+        if pieces
+            .iter()
+            .any(|piece| hanging(piece) && piece.iter().any(|&n| loaded(n)))
+        {
+            return true;
+        }
+        let driven = body
+            .loads
+            .iter()
+            .any(|l| !released[l.node] && l.force != Vector3::zeros())
+            || body
+                .supports
+                .iter()
+                .any(|s| !released[s.node] && s.displacement != Vector3::zeros())
+            || obstacles.iter().any(|o| o.offset(1, 1) != Vector3::zeros());
+        !driven
     }
 
     /// Take `nodes` of body `b` out of the solve: their members carry nothing, their loads are

@@ -178,7 +178,8 @@ fn body_report(
     let mut state = post_process(body, &part.dofs, &part.u, forces, &internal, members);
     state.iterations = iterations;
     // Relative to the largest of applied, reaction and contact forces (a body held by
-    // contact alone has no reactions), and at least the force floor.
+    // contact alone has no reactions), and at least the force floor (which holds the run's
+    // largest scale so far: forces that vanish, as a split body's, leave a real scale).
     let unbalanced = |dofs: &[usize]| -> Real {
         dofs.iter()
             .map(|&dof| (internal[dof] - forces[dof]).powi(2))
@@ -188,6 +189,7 @@ fn body_report(
     let out_of_balance = unbalanced(&part.dofs.free);
     let reacted = unbalanced(&part.dofs.supported);
     let scale = norm(forces).max(reacted).max(norm(&fc)).max(p.force_floor);
+    state.force_scale = scale;
     state.residual = if scale > 0.0 {
         out_of_balance / scale
     } else {

@@ -201,6 +201,10 @@ pub struct ContactSolver {
     /// Per body, its nodes removed from the solve (a piece that fell off: held in place,
     /// touching nothing); empty when none is.
     pub(crate) removed: Vec<Vec<bool>>,
+    /// The largest force scale a step of the run reported so far, N: the floor of the next
+    /// steps' residuals, so a body whose forces vanish (split, unloaded) is not measured
+    /// against round-off.
+    pub(crate) largest_force_scale: Real,
 }
 
 impl ContactSolver {
@@ -319,6 +323,7 @@ impl ContactSolver {
             times,
             query_seconds: 0.0,
             removed: Vec::new(),
+            largest_force_scale: 0.0,
         })
     }
 
@@ -507,13 +512,24 @@ impl ContactSolver {
             tolerance,
             max_iterations,
             move_cap: self.move_cap,
-            force_floor: self.force_floor(),
+            // The run's largest force scale so far (none at step 0: a run starts over).
+            force_floor: self.force_floor().max(if step == 0 {
+                0.0
+            } else {
+                self.largest_force_scale
+            }),
             friction: self.friction.as_ref(),
         };
         let evaluated = problem.evaluate(&mut self.normals, &self.parts);
         out.negative_pivots = self.coupled.negative_pivots;
         out.linear_iterations = self.coupled.linear_iterations() - self.linear_before;
-        finish(&problem, &self.parts, evaluated, out)
+        let out = finish(&problem, &self.parts, evaluated, out)?;
+        self.largest_force_scale = out
+            .states
+            .iter()
+            .map(|s| s.force_scale)
+            .fold(problem.force_floor, Real::max);
+        Ok(out)
     }
 
     /// The full displacements of the condensed bodies (see [`CondensedSolver::expand`]; 0 on

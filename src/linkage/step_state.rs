@@ -27,6 +27,10 @@ pub struct StepState {
     /// Out-of-balance force at the free DOFs over the largest of applied force and reaction
     /// norms (0 when nothing is loaded).
     pub residual: Real,
+    /// The force the contact solver took the residual relative to, N (the largest of the
+    /// applied, reaction and contact force norms, and of the run's largest so far); 0 where
+    /// the residual is not a contact step's.
+    pub force_scale: Real,
     /// Equilibrium iterations this step took (1 for a linear step, Newton iterations otherwise).
     pub iterations: usize,
     /// How many times the step's load increment was halved because Newton did not converge.
@@ -44,6 +48,14 @@ pub struct StepState {
     /// iterate differs from the solution by less than the displacement tolerance; always 0 for
     /// a linear body.
     pub negative_pivots: usize,
+    /// The most negative pivots of any tangent factored during the step's Newton iterations
+    /// (the increments that converged); above [`Self::negative_pivots`] when an iterate
+    /// crossed an unstable region on its way to the solution: the load passed a limit point
+    /// within the step (a snap-through). Always 0 for a linear body.
+    pub negative_pivots_met: usize,
+    /// Whether the tangent was solved by conjugate gradients, which count no pivots: then
+    /// `negative_pivots` (0) says nothing of the state's stability.
+    pub pivots_unknown: bool,
     /// Members broken so far and in this step, pieces fallen off: a body with breaking
     /// members only.
     pub fracture: Option<crate::linkage::fracture::FractureState>,

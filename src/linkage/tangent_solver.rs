@@ -26,6 +26,8 @@ pub(crate) struct TangentSolver {
     assembly: StiffnessAssembly,
     /// Force scale of the current increment, N: iterative solves stop at tolerance × it.
     reference: Real,
+    /// Whether an iterative solve did not converge and the tangent was factored instead.
+    fell_back: bool,
 }
 
 /// Why the tangent could not be factored.
@@ -64,6 +66,7 @@ impl TangentSolver {
             iterative,
             assembly: assembly.clone(),
             reference: 0.0,
+            fell_back: false,
         })
     }
 
@@ -75,6 +78,11 @@ impl TangentSolver {
     /// Whether the tangent is solved by conjugate gradients.
     pub(crate) fn is_iterative(&self) -> bool {
         self.iterative.is_some()
+    }
+
+    /// Whether an iterative solve fell back to factoring the tangent (at least once).
+    pub(crate) fn fell_back(&self) -> bool {
+        self.fell_back
     }
 
     /// Conjugate-gradient iterations so far (0 for a direct body).
@@ -170,6 +178,7 @@ impl TangentSolver {
                 }
             }
             // Not converged (or no hierarchy: a singular or indefinite tangent): factor it.
+            self.fell_back = true;
             let values = it.lower_values(&self.assembly);
             self.factorize_direct(&values)?;
         }

@@ -1,5 +1,7 @@
 //! Warnings of instabilities under load control: a step whose solved tangent has negative
-//! pivots (the body is past a limit point or buckles), or whose displacements jump by far more
+//! pivots (the body is past a limit point or buckles), a step whose Newton iterations met
+//! negative pivots on the way to a stable solution (a limit point passed within the step), or
+//! whose displacements jump by far more
 //! than the step before them although what drives them did not (a snap-through to a distant
 //! equilibrium). Load control cannot follow such a path; the arc-length method can. Bodies on
 //! an arc-length path are not watched: passing limit points is what it is for.
@@ -39,6 +41,8 @@ struct Kept {
     loads: Vec<Vector3<Real>>,
     /// Contact force totals per pair, N.
     contact: Vec<Real>,
+    /// Negative pivots of its solved tangent.
+    negative_pivots: usize,
     /// The change that step made (none for the first step watched).
     increment: Option<Increment>,
 }
@@ -95,16 +99,29 @@ impl InstabilityWatch {
                 if state.negative_pivots > 0 {
                     warnings.push(negative_pivots_warning(body, step, state.negative_pivots));
                 }
-                if let (Some(now), Some(before)) = (increment, kept.increment) {
-                    if is_jump(&now, &before, body.size()) {
+                let jumped = match (increment, kept.increment) {
+                    (Some(now), Some(before)) if is_jump(&now, &before, body.size()) => {
                         warnings.push(jump_warning(body, step, &now, &before));
+                        true
                     }
+                    _ => false,
+                };
+                // A stable end reached through an unstable region from a stable start (an
+                // unstable start was told at its own step), which the jump did not already tell.
+                if state.negative_pivots == 0
+                    && state.negative_pivots_met > 0
+                    && follows
+                    && kept.negative_pivots == 0
+                    && !jumped
+                {
+                    warnings.push(limit_passed_warning(body, step, state.negative_pivots_met));
                 }
             }
             *kept = Kept {
                 displacements: state.displacements.clone(),
                 loads,
                 contact,
+                negative_pivots: state.negative_pivots,
                 increment,
             };
         }
@@ -143,6 +160,14 @@ fn driven(now: &Increment, before: &Increment) -> Real {
 fn negative_pivots_warning(body: &Body, step: usize, count: usize) -> String {
     format!(
         "step {step}: body '{}': the tangent stiffness at the solved state has {count} negative pivot{}: the body is past a limit point or buckles, an unstable equilibrium that load control cannot follow (it may jump to a distant state or fail); trace the path with [bodies.path] method = \"arc_length\"",
+        body.name,
+        if count == 1 { "" } else { "s" }
+    )
+}
+
+fn limit_passed_warning(body: &Body, step: usize, count: usize) -> String {
+    format!(
+        "step {step}: body '{}': a limit point was passed within the step: the solved states before and after it are stable, but the tangent stiffness between them (at the Newton iterates, or sampled on the way from one state to the other) has {count} negative pivot{}: an unstable region lies between them: the body probably snapped through to a distant equilibrium that load control cannot follow; trace the path with [bodies.path] method = \"arc_length\"",
         body.name,
         if count == 1 { "" } else { "s" }
     )

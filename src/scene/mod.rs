@@ -34,6 +34,7 @@ pub mod atomic_file;
 pub mod batch;
 mod bounds;
 mod build;
+mod capacity;
 mod check;
 mod contact_concentration;
 mod contact_pairs;

@@ -170,6 +170,10 @@ pub struct StepSummary {
     /// bodies: 0 for a stable equilibrium (and for every linear step), k > 0 when the
     /// equilibrium is unstable in k directions (past a limit point, on a falling branch).
     pub negative_pivots: usize,
+    /// Nonlinear bodies whose tangent conjugate gradients solved, which count no pivots: their
+    /// stability is unknown, and `negative_pivots` counts the others only (absent when none).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub pivots_unknown: usize,
     /// Contact iterations (0 without contact).
     pub contact_iterations: usize,
     /// Contacts that stick (friction holds them; absent without contact).

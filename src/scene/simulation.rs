@@ -7,6 +7,7 @@ use crate::contact::{
 use crate::linkage::fracture::{breaks_members, BreakEvent, FractureState};
 use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
 use crate::scene::contact_concentration::concentrated_contact_warnings;
+use crate::scene::capacity::CapacityWatch;
 use crate::scene::instability::InstabilityWatch;
 use crate::scene::results::{
     BodyFracture, BodyResult, BodySize, BreakRecord, Collapse, ContactForce, PairForce, StepResult,
@@ -39,6 +40,8 @@ pub struct Simulation<'w> {
     strain_warned: Vec<bool>,
     /// The contact pairs (body, other) warned about as carried by one node already.
     concentration_warned: Vec<(String, String)>,
+    /// Each breaking body's peak carried load.
+    capacity: CapacityWatch,
     /// Breaking members in a scene with contact: the bodies as they break.
     fracture: Option<ContactFracture>,
     /// Per body, in a scene solved body by body, the watch for its self-contact (breaking
@@ -118,6 +121,7 @@ impl<'w> Simulation<'w> {
             watch: InstabilityWatch::default(),
             strain_warned: vec![false; world.bodies.len()],
             concentration_warned: Vec::new(),
+            capacity: CapacityWatch::default(),
             fracture,
             self_watch,
         })
@@ -192,6 +196,11 @@ impl<'w> Simulation<'w> {
             }
             result.bodies.push(written);
         }
+        summary
+            .warnings
+            .extend(residual_warnings(&world.bodies, step, &states));
+        let failed = self.capacity.warnings(&world.bodies, step, &states);
+        summary.warnings.extend(failed);
         let warnings = self
             .watch
             .warnings(&world.bodies, step, &states, &summary.contact_forces);
@@ -292,6 +301,14 @@ impl<'w> Simulation<'w> {
         summary.iterations = solved.newton_iterations;
         summary.cuts = solved.cuts;
         summary.negative_pivots = solved.negative_pivots;
+        // Conjugate gradients count no pivots: the stability of a nonlinear body solved by
+        // them is unknown (a linear one's stiffness is positive definite).
+        summary.pivots_unknown = (0..world.bodies.len())
+            .filter(|&b| {
+                world.bodies[b].is_nonlinear()
+                    && contact.solver_used(b) != crate::linkage::SolverUsed::Direct
+            })
+            .count();
         summary.linear_iterations = solved.linear_iterations;
         summary.contact_iterations = solved.contact_iterations;
         summary.sticking = solved.sticking;
@@ -530,6 +547,37 @@ fn self_watches(world: &World) -> Vec<Option<SelfContactWatch>> {
         .collect()
 }
 
+/// A step's relative residual above this is worth a warning: four orders of magnitude above
+/// the default Newton tolerance (1e-10), where a linear breaking body's solve already counts
+/// as inaccurate.
+pub const RESIDUAL_WARNING: Real = 1e-6;
+
+/// One warning per body whose solved state leaves an out-of-balance force above
+/// [`RESIDUAL_WARNING`] of the force it is measured against (in a contact scene the run's
+/// largest so far, so a body whose forces vanish does not alarm for nothing).
+fn residual_warnings(bodies: &[Body], step: usize, states: &[StepState]) -> Vec<String> {
+    bodies
+        .iter()
+        .zip(states)
+        .filter(|(_, s)| s.residual > RESIDUAL_WARNING)
+        .map(|(body, s)| {
+            format!(
+                "step {step}: body '{}': the out-of-balance force is {:.2e} of the force it is measured against{}: the state is not in equilibrium to the accuracy asked for; look for a warning above on why the solve stopped short, or try more steps",
+                body.name,
+                s.residual,
+                if s.force_scale > 0.0 {
+                    format!(
+                        " ({:.3e} N: the largest of the step's forces and of the run's so far)",
+                        s.force_scale
+                    )
+                } else {
+                    String::new()
+                }
+            )
+        })
+        .collect()
+}
+
 /// The summary line of `step` before anything is solved.
 fn empty_summary(step: usize, load_factor: Real) -> StepSummary {
     StepSummary {
@@ -538,6 +586,7 @@ fn empty_summary(step: usize, load_factor: Real) -> StepSummary {
         iterations: 0,
         cuts: 0,
         negative_pivots: 0,
+        pivots_unknown: 0,
         residuals: Vec::new(),
         contact_iterations: 0,
         sticking: 0,
@@ -586,6 +635,7 @@ fn add_newton_counts(summary: &mut StepSummary, state: &StepState) {
     summary.cuts += state.cuts;
     summary.linear_iterations += state.linear_iterations;
     summary.negative_pivots += state.negative_pivots;
+    summary.pivots_unknown += usize::from(state.pivots_unknown);
     if let Some(lambda) = state.load_factor {
         summary.load_factor = lambda;
     }
@@ -608,4 +658,32 @@ fn contact_forces(body: &Body, contacts: &[NodeContact]) -> Vec<ContactForce> {
             slip: c.slip.as_slice()[..d].to_vec(),
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linkage::Dimension;
+
+    /// A residual of 1.2e-3 of the run's largest force warns, naming the body, the value and
+    /// the scale; one at the Newton tolerance does not.
+    #[test]
+    fn a_residual_warns_only_when_really_large() {
+        let bodies = [Body::new("block", Dimension::Three)];
+        let state = |residual: Real| StepState {
+            residual,
+            force_scale: 2.5e4,
+            ..Default::default()
+        };
+        assert!(residual_warnings(&bodies, 9, &[state(1e-10)]).is_empty());
+        assert!(residual_warnings(&bodies, 9, &[state(RESIDUAL_WARNING)]).is_empty());
+        let w = residual_warnings(&bodies, 9, &[state(1.2e-3)]);
+        assert_eq!(w.len(), 1);
+        assert!(
+            w[0].starts_with("step 9: body 'block': the out-of-balance force is 1.20e-3")
+                && w[0].contains("2.500e4 N"),
+            "{}",
+            w[0]
+        );
+    }
 }

@@ -56,6 +56,12 @@ pub const DEFAULT_REFACTOR_EVERY: usize = 128;
 /// a mechanism.
 const SINGULAR_RATIO: Real = 1e-6;
 
+/// Members whose critical fractions of a load increment differ by at most this (relative to
+/// the fraction, at least 1) reach their strength together: they break in one event, before
+/// the solution is corrected, as symmetric members do (breaking one of them first would break
+/// the symmetry by rounding and let its twin carry what it left).
+pub const TIE: Real = 1e-9;
+
 /// Per member its tensile and compressive strength (Pa, positive, infinite for none), or
 /// `None` when it does not break.
 pub type MemberLimits = Vec<Option<(Real, Real)>>;
@@ -358,9 +364,11 @@ impl BreakingEquilibrium {
         u
     }
 
-    /// The next member to break between the loads at pattern factors `f0` (t = 0) and `f1`
-    /// (t = 1): the smallest critical fraction, ties by member number.
-    fn next_break(&self, body: &Body, f0: &[Real], f1: &[Real]) -> Option<BreakEvent> {
+    /// The next members to break between the loads at pattern factors `f0` (t = 0) and `f1`
+    /// (t = 1): the one of smallest critical fraction and every member that ties with it
+    /// (within [`TIE`]: symmetric members reach their strength together and break in one
+    /// event), in member order; empty when none is beyond its strength at `f1`.
+    fn next_breaks(&self, body: &Body, f0: &[Real], f1: &[Real]) -> Vec<BreakEvent> {
         let d = self.dofs.dofs_per_node;
         let u0 = self.combine(f0, |p| &p.displacements);
         let u1 = self.combine(f1, |p| &p.displacements);
@@ -392,32 +400,37 @@ impl BreakingEquilibrium {
                 critical_fraction(a, end - a, tensile, compressive)
             })
             .collect();
-        let mut best: Option<BreakEvent> = None;
-        for (m, t) in fractions.into_iter().enumerate() {
-            if let Some(t) = t {
-                if best.is_none_or(|b| t < b.fraction) {
-                    best = Some(BreakEvent {
-                        member: m,
-                        fraction: t,
-                        tooth: None,
-                    });
-                }
-            }
-        }
-        best
+        let Some(least) = fractions.iter().flatten().copied().reduce(Real::min) else {
+            return Vec::new();
+        };
+        let tie = TIE * least.abs().max(1.0);
+        fractions
+            .into_iter()
+            .enumerate()
+            .filter_map(|(m, t)| {
+                let t = t?;
+                (t - least <= tie).then_some(BreakEvent {
+                    member: m,
+                    fraction: t,
+                    tooth: None,
+                })
+            })
+            .collect()
     }
 
     /// Member `m` reached its strength: move it to its next tooth (returned, 1-based: the
-    /// tooth it passed) when it has one, else break it. Either way every pattern's solution is
-    /// corrected; when a break leaves `K_ff` singular the pieces it left unsupported are
-    /// removed (returned) and `K_ff` refactored. `Err(())` when the supported part itself is a
-    /// mechanism.
-    #[allow(clippy::type_complexity)]
-    fn break_member(
+    /// tooth it passed) when it has one, else break it. Every pattern's solution is corrected
+    /// by the rank-one update, unless `stale` (an earlier member of the same event left `K_ff`
+    /// singular: the stiffness only is changed, and the refactorization after the event solves
+    /// the patterns again). Returns the tooth passed and whether the update found `K_ff`
+    /// singular; `Err(())` when a refactorization due by the update's rank finds the
+    /// supported part a mechanism.
+    fn remove_member(
         &mut self,
         body: &Body,
         m: usize,
-    ) -> Result<(Option<usize>, Vec<FallenPiece>), ()> {
+        stale: bool,
+    ) -> Result<(Option<usize>, bool), ()> {
         let d = self.dofs.dofs_per_node;
         let next = self.tooth[m] + 1;
         let softened = self.teeth[m].get(next).copied();
@@ -431,7 +444,11 @@ impl BreakingEquilibrium {
                 }
             }
         }
-        let elongations = self.elongations(body, m);
+        let elongations = if stale {
+            Vec::new()
+        } else {
+            self.elongations(body, m)
+        };
         if let Some(t) = softened {
             self.tooth[m] = next;
             self.modulus_factor[m] = t.stiffness_factor;
@@ -444,6 +461,10 @@ impl BreakingEquilibrium {
             self.broken.push(m);
         }
         let passed = softened.map(|_| next);
+        if stale {
+            self.stiffness[m] = k_after;
+            return Ok((passed, false));
+        }
         let t = Instant::now();
         let removal = match (self.cholesky.as_mut(), self.factor_update.as_mut()) {
             (Some(c), Some(u)) if !g.is_empty() => u.remove(c, &g, k).map(Some),
@@ -466,27 +487,53 @@ impl BreakingEquilibrium {
                 if self.rank() >= self.refactor_every && !self.refactor(body) {
                     return Err(());
                 }
-                Ok((passed, Vec::new()))
+                Ok((passed, false))
             }
-            Ok(None) => Ok((passed, Vec::new())),
-            // A tooth leaves the member some stiffness: a drop so large that K_ff looks
-            // singular to the update is taken as it is, by refactoring.
-            Err(_) if passed.is_some() => {
+            Ok(None) => Ok((passed, false)),
+            Err(_) => Ok((passed, true)),
+        }
+    }
+
+    /// The members of one event (tied at their strength) break, or pass a tooth, together
+    /// (see [`Self::remove_member`]); returns per member the tooth passed. When the event
+    /// leaves `K_ff` singular: a tooth (which leaves the member some stiffness) is taken as it
+    /// is, by refactoring; after a break the pieces it left unsupported are removed (returned)
+    /// and `K_ff` refactored. `Err` with the member that made it a mechanism when the
+    /// supported part is one, or when what came loose is a collapse (see
+    /// [`Self::release_pieces`]).
+    #[allow(clippy::type_complexity)]
+    fn break_members(
+        &mut self,
+        body: &Body,
+        members: &[usize],
+    ) -> Result<(Vec<Option<usize>>, Vec<FallenPiece>), usize> {
+        let mut passed = Vec::with_capacity(members.len());
+        // The first member whose removal left K_ff singular, and whether it broke.
+        let mut singular: Option<(usize, bool)> = None;
+        for &m in members {
+            let (tooth, found) = self
+                .remove_member(body, m, singular.is_some())
+                .map_err(|()| m)?;
+            if found && singular.is_none() {
+                singular = Some((m, tooth.is_none()));
+            }
+            passed.push(tooth);
+        }
+        match singular {
+            None => Ok((passed, Vec::new())),
+            Some((m, false)) => {
                 if !self.refactor(body) {
-                    return Err(());
+                    return Err(m);
                 }
                 Ok((passed, Vec::new()))
             }
-            Err(_) => {
-                let pieces = self.release_pieces(body);
-                if pieces.is_empty() {
-                    return Err(());
-                }
-                if !self.refactor(body) {
-                    return Err(());
+            Some((m, true)) => {
+                let pieces = self.release_pieces(body).ok_or(m)?;
+                if pieces.is_empty() || !self.refactor(body) {
+                    return Err(m);
                 }
                 Ok((
-                    None,
+                    passed,
                     pieces
                         .into_iter()
                         .map(|nodes| FallenPiece { member: m, nodes })
@@ -501,7 +548,12 @@ impl BreakingEquilibrium {
     /// its dimension (a 2D node hanging on one member, a 3D node on two) turns freely about
     /// them and goes with its members. Repeated until nothing more comes loose; the pieces
     /// found (nodes ascending, by first node), empty when the singular mode is elsewhere.
-    fn release_pieces(&mut self, body: &Body) -> Vec<Vec<usize>> {
+    ///
+    /// `None` (nothing removed) when what came loose is the structure's collapse rather than a
+    /// piece falling off: a loaded piece still hanging on the rest by members (a mechanism
+    /// under load: it would swing, not fall), or a loss that leaves the rest carrying no load
+    /// at all (every load went with the pieces: nothing is left to hold them).
+    fn release_pieces(&mut self, body: &Body) -> Option<Vec<Vec<usize>>> {
         let members: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
         let intact: Vec<bool> = self.stiffness.iter().map(|&s| s > 0.0).collect();
         let pieces = released_pieces(
@@ -511,29 +563,64 @@ impl BreakingEquilibrium {
             &self.fallen_node,
             self.dofs.dofs_per_node,
         );
+        let mut released = self.fallen_node.clone();
         for &n in pieces.iter().flatten() {
-            self.fallen_node[n] = true;
+            released[n] = true;
         }
+        let d = self.dofs.dofs_per_node;
+        let loaded = |n: usize| {
+            self.patterns
+                .iter()
+                .any(|p| p.forces[n * d..(n + 1) * d].iter().any(|&f| f != 0.0))
+        };
+        let hanging = |piece: &[usize]| {
+            members.iter().zip(&intact).any(|(&[a, b], &i)| {
+                i && (piece.binary_search(&a).is_ok() && !released[b]
+                    || piece.binary_search(&b).is_ok() && !released[a])
+            })
+        };
+        if pieces
+            .iter()
+            .any(|piece| hanging(piece) && piece.iter().any(|&n| loaded(n)))
+        {
+            return None;
+        }
+        let rest_loaded = self.patterns.iter().any(|p| {
+            (0..self.supported_node.len()).any(|n| {
+                !released[n]
+                    && (0..d).any(|k| match self.dofs.slots[n * d + k] {
+                        DofSlot::Free(_) => p.forces[n * d + k] != 0.0,
+                        _ => p.displacements[n * d + k] != 0.0,
+                    })
+            })
+        });
+        if !pieces.is_empty() && !rest_loaded {
+            return None;
+        }
+        self.fallen_node = released;
         for (j, &[a, b]) in members.iter().enumerate() {
             if self.fallen_node[a] || self.fallen_node[b] {
                 self.stiffness[j] = 0.0;
             }
         }
-        pieces
+        Some(pieces)
     }
 
-    /// Break the next member the load of `step` (of `steps`) breaks, if any, and return its
-    /// event; pieces that fall off are appended to `fallen`. [`SolveError::Collapse`] (its
-    /// `breaks` holding this event alone) when the break leaves the supported part a mechanism.
+    /// Break the next members the load of `step` (of `steps`) breaks, if any: the first to
+    /// reach its strength and those tied with it (one event), and return their events, in
+    /// member order (empty: none); pieces that fall off are appended to `fallen`.
+    /// [`SolveError::Collapse`] (its `breaks` holding this event alone) when the event leaves
+    /// the supported part a mechanism, or loses the structure's load path (see
+    /// [`Self::release_pieces`]).
     pub fn next_event(
         &mut self,
         body: &Body,
         step: usize,
         steps: usize,
         fallen: &mut Vec<FallenPiece>,
-    ) -> Result<Option<BreakEvent>, SolveError> {
+    ) -> Result<Vec<BreakEvent>, SolveError> {
         if step == 0 {
-            return Ok(None);
+            return Ok(Vec::new());
         }
         let factors = |s: usize| -> Vec<Real> {
             self.patterns
@@ -542,29 +629,32 @@ impl BreakingEquilibrium {
                 .collect()
         };
         let (f0, f1) = (factors(step - 1), factors(step));
-        let Some(mut event) = self.next_break(body, &f0, &f1) else {
-            return Ok(None);
-        };
-        // The member's elongation at the break, before its removal changes the patterns.
-        let t = event.fraction;
-        let elongation: Real = self
-            .elongations(body, event.member)
-            .iter()
-            .zip(f0.iter().zip(&f1))
-            .map(|(e, (a, b))| e * (a + t * (b - a)))
-            .sum();
-        self.in_tension[event.member] = elongation > 0.0;
-        match self.break_member(body, event.member) {
-            Ok((tooth, pieces)) => {
+        let mut events = self.next_breaks(body, &f0, &f1);
+        // Each member's elongation at its break, before the removals change the patterns.
+        for event in &events {
+            let t = event.fraction;
+            let elongation: Real = self
+                .elongations(body, event.member)
+                .iter()
+                .zip(f0.iter().zip(&f1))
+                .map(|(e, (a, b))| e * (a + t * (b - a)))
+                .sum();
+            self.in_tension[event.member] = elongation > 0.0;
+        }
+        let members: Vec<usize> = events.iter().map(|e| e.member).collect();
+        match self.break_members(body, &members) {
+            Ok((teeth, pieces)) => {
                 fallen.extend(pieces);
-                event.tooth = tooth;
-                Ok(Some(event))
+                for (event, tooth) in events.iter_mut().zip(teeth) {
+                    event.tooth = tooth;
+                }
+                Ok(events)
             }
-            Err(()) => Err(SolveError::Collapse {
+            Err(member) => Err(SolveError::Collapse {
                 body: body.name.clone(),
                 step,
-                member: event.member,
-                breaks: vec![event],
+                member,
+                breaks: events,
             }),
         }
     }
@@ -582,8 +672,8 @@ impl BreakingEquilibrium {
         let mut fracture = FractureState::default();
         loop {
             match self.next_event(body, step, steps, &mut fracture.fallen) {
-                Ok(Some(event)) => fracture.breaks.push(event),
-                Ok(None) => break,
+                Ok(events) if events.is_empty() => break,
+                Ok(events) => fracture.breaks.extend(events),
                 Err(SolveError::Collapse {
                     body,
                     step,

@@ -31,9 +31,11 @@ impl NewtonEquilibrium {
                 t + dt
             };
             let saved = self.u.clone();
+            self.increment_pivots = 0;
             match self.increment(body, t1, steps) {
                 Ok(n) => {
                     iterations += n;
+                    self.step_pivots = self.step_pivots.max(self.increment_pivots);
                     t = t1;
                     size.succeeded();
                     if self.path.len() == PATH_POINTS {

@@ -86,6 +86,12 @@ pub struct NewtonEquilibrium {
     previous: Vec<Real>,
     /// Negative pivots of the last factored tangent.
     negative_pivots: usize,
+    /// The most negative pivots of a tangent factored in the current increment, and in the
+    /// converged increments of the step being solved.
+    increment_pivots: usize,
+    step_pivots: usize,
+    /// Norm of the displacement change of the last load-control step, m (0 before one).
+    last_change: Real,
     /// The largest force scale (applied or reaction norm, N) and displacement norm (m) of the
     /// states converged so far: floors of what "relative" refers to, so that unloading back to
     /// zero (where both vanish) still converges.
@@ -131,6 +137,15 @@ pub(crate) fn follower_forces(body: &Body, u: &[Real], t: Real, steps: usize, ou
 /// part, below which the symmetric part is taken as the whole (round-off of a closed surface).
 const SYMMETRIC_LOAD_STIFFNESS: Real = 1e-8;
 
+/// A load-control step whose displacement change is more than this many times the step
+/// before's has the tangent sampled between its start and end (see
+/// `NewtonEquilibrium::watch_path`): a softening body's steps grow by less (a body at 95 % of
+/// a limit load, about 1.4 times), a snap-through's by far more.
+const PATH_CHECK_RATIO: Real = 2.0;
+
+/// Points between a checked step's start and end at which the tangent is factored.
+const PATH_SAMPLES: usize = 3;
+
 /// Converged states kept for the extrapolation (three: up to a quadratic through them).
 const PATH_POINTS: usize = 3;
 
@@ -170,6 +185,9 @@ impl NewtonEquilibrium {
             lambda: 0.0,
             step: 0,
             negative_pivots: 0,
+            increment_pivots: 0,
+            step_pivots: 0,
+            last_change: 0.0,
             force_floor: 0.0,
             displacement_floor: 0.0,
             path: vec![(0.0, vec![0.0; nd])],
@@ -242,7 +260,11 @@ impl NewtonEquilibrium {
     /// Which linear solver the tangent gets: direct or iterative.
     pub fn solver_used(&self) -> SolverUsed {
         if self.solver.as_ref().is_some_and(|s| s.is_iterative()) {
-            SolverUsed::Iterative
+            if self.solver.as_ref().is_some_and(|s| s.fell_back()) {
+                SolverUsed::IterativeThenDirect
+            } else {
+                SolverUsed::Iterative
+            }
         } else {
             SolverUsed::Direct
         }
@@ -262,6 +284,7 @@ impl NewtonEquilibrium {
             self.lambda = 0.0;
             self.step = 0;
             self.negative_pivots = 0;
+            self.last_change = 0.0;
             self.force_floor = 0.0;
             self.displacement_floor = 0.0;
             // Step 0 (no load, no support moved) is in equilibrium undeformed.
@@ -270,10 +293,16 @@ impl NewtonEquilibrium {
         let mut iterations = 0;
         let mut cuts = 0;
         let cg_before = self.linear_iterations();
+        self.step_pivots = 0;
         while self.step < step {
             let target = self.step + 1;
             let (i, c) = match body.newton.path {
-                PathMethod::Schedules => self.advance_schedules(body, target, steps)?,
+                PathMethod::Schedules => {
+                    let start = self.u.clone();
+                    let done = self.advance_schedules(body, target, steps)?;
+                    self.watch_path(body, &start);
+                    done
+                }
                 PathMethod::ArcLength { length } => {
                     self.advance_arc_length(body, target, length)?
                 }
@@ -304,6 +333,47 @@ impl NewtonEquilibrium {
         Ok(state)
     }
 
+    /// After a load-control step from displacement `start` to the current one: when the step
+    /// moved more than [`PATH_CHECK_RATIO`] times the step before it, factor the tangent at
+    /// points between the two states ([`PATH_SAMPLES`] along the straight line) and count
+    /// their negative pivots into the step's (`negative_pivots_met` of the state): a stable
+    /// start and end with an unstable region between them is a limit point passed within the
+    /// step, which the solved states alone do not show. Ordinary steps cost nothing more.
+    fn watch_path(&mut self, body: &Body, start: &[Real]) {
+        let change = self
+            .u
+            .iter()
+            .zip(start)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<Real>()
+            .sqrt();
+        let before = std::mem::replace(&mut self.last_change, change);
+        if !(change > PATH_CHECK_RATIO * before && before > 0.0) || self.solver.is_none() {
+            return;
+        }
+        let end = self.u.clone();
+        let (pivots, increment) = (self.negative_pivots, self.increment_pivots);
+        for k in 1..=PATH_SAMPLES {
+            let s = k as Real / (PATH_SAMPLES + 1) as Real;
+            for ((u, a), b) in self.u.iter_mut().zip(start).zip(&end) {
+                *u = a + s * (b - a);
+            }
+            let t = Instant::now();
+            self.fill_tangent(body);
+            self.times.assembly += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            if let Ok(negative) = self.factorize() {
+                self.step_pivots = self.step_pivots.max(negative);
+            }
+            self.times.numeric += t.elapsed().as_secs_f64();
+        }
+        self.u = end;
+        // The factor now holds a sample's tangent: the next increment refactors before it
+        // solves (its predictor and every correction do); the counts are the end's again.
+        self.negative_pivots = pivots;
+        self.increment_pivots = increment;
+    }
+
     /// The full state at the current displacement (post-processing shared with the linear
     /// solve).
     fn state(&self, body: &Body, steps: usize) -> StepState {
@@ -328,6 +398,8 @@ impl NewtonEquilibrium {
         let out_of_balance = free_out_of_balance(&self.dofs, &forces, &internal);
         state.residual = Convergence::relative(out_of_balance, scale);
         state.negative_pivots = self.negative_pivots;
+        state.negative_pivots_met = self.step_pivots.max(self.negative_pivots);
+        state.pivots_unknown = self.solver.as_ref().is_some_and(|s| s.is_iterative());
         state
     }
 
@@ -414,6 +486,7 @@ impl NewtonEquilibrium {
         };
         let negative = solver.factorize(&self.values)?;
         self.negative_pivots = negative;
+        self.increment_pivots = self.increment_pivots.max(negative);
         Ok(negative)
     }
 
