@@ -7,6 +7,7 @@ use crate::contact::settle::{largest_nodal_move, BodyPart, Problem, STABILISATIO
 use crate::contact::{ActiveContact, ContactError, ContactSet};
 use crate::linalg::{CholeskyError, LowRankCorrection, SparseColumn};
 use crate::linkage::body_state::{fill_tangent, internal_force_vector, norm};
+use crate::linkage::dynamics::InertiaTerm;
 use crate::linkage::line_search::backtrack;
 use crate::linkage::{Body, Convergence, PhaseTimes, SolverUsed, StiffnessAssembly};
 use crate::Real;
@@ -23,6 +24,8 @@ pub(crate) struct CoupledSolver {
     coupling: Vec<(usize, usize)>,
     /// The contact set the current factorization was made with (not stabilised).
     factored: Option<ContactSet>,
+    /// The inertia coefficients per body it was made with (empty: a load step).
+    factored_inertia: Vec<Real>,
     /// The body whose tangent was singular last (for messages).
     pub(crate) unheld: usize,
     /// Negative pivots of the last tangent factored (LDLᵀ; 0 when positive definite).
@@ -62,6 +65,7 @@ impl CoupledSolver {
             node_offsets,
             coupling: Vec::new(),
             factored: None,
+            factored_inertia: Vec::new(),
             unheld: 0,
             negative_pivots: 0,
             iterative,
@@ -123,7 +127,9 @@ impl CoupledSolver {
     /// The out-of-balance force `F + f_c − f_int` at the free DOFs of all bodies (global
     /// order), N, for the contacts `evaluated` at the current displacements; and the force
     /// scale it is measured against: the largest of the applied, reaction and contact force
-    /// norms, at least the force floor.
+    /// norms, at least the force floor. Within a time step (`p.inertia`), the inertia force
+    /// `c M (u − u*)` of each body ([`InertiaTerm`]) is taken off too, and its norm is one
+    /// more force scale (a body in free flight has no other force).
     pub(crate) fn out_of_balance(
         &self,
         p: &Problem,
@@ -131,10 +137,18 @@ impl CoupledSolver {
         evaluated: &Evaluation,
     ) -> (Vec<Real>, Real) {
         let mut r = vec![0.0; self.system.n];
-        let (mut applied, mut reacted, mut contact) = (0.0, 0.0, 0.0);
+        let (mut applied, mut reacted, mut contact, mut inertial) = (0.0, 0.0, 0.0, 0.0);
         for ((b, body), fc) in p.bodies.iter().enumerate().zip(&evaluated.forces) {
             let part = &parts[b];
-            let internal = internal_force_vector(body, &part.u);
+            let mut internal = internal_force_vector(body, &part.u);
+            if let Some(term) = p.inertia.and_then(|i| i.get(b)) {
+                let mut f = vec![0.0; internal.len()];
+                term.add_force(&part.u, &mut f);
+                inertial += f.iter().map(|f| f * f).sum::<Real>();
+                for (i, f) in internal.iter_mut().zip(&f) {
+                    *i += f;
+                }
+            }
             let offset = self.system.offsets[b];
             for (i, &dof) in part.dofs.free.iter().enumerate() {
                 r[offset + i] = p.forces[b][dof] + fc[dof] - internal[dof];
@@ -145,7 +159,11 @@ impl CoupledSolver {
             applied += p.forces[b].iter().map(|f| f * f).sum::<Real>();
             contact += fc.iter().map(|f| f * f).sum::<Real>();
         }
-        let scale = applied.sqrt().max(reacted.sqrt()).max(contact.sqrt());
+        let scale = applied
+            .sqrt()
+            .max(reacted.sqrt())
+            .max(contact.sqrt())
+            .max(inertial.sqrt());
         (r, scale.max(p.force_floor))
     }
 
@@ -188,6 +206,7 @@ impl CoupledSolver {
             let reuse = linear
                 && self.iterative.is_none()
                 && self.factored.as_ref() == Some(p.set)
+                && self.factored_inertia == inertia_coefficients(p)
                 && iterations > 0
                 && monitor.converging_fast();
             let (stabilised, delta) = if reuse {
@@ -214,6 +233,7 @@ impl CoupledSolver {
                         self.fell_back |= self.iterative.is_some();
                         let stabilised = self.factorize_filled(p, times)?;
                         self.factored = (!stabilised).then(|| p.set.clone());
+                        self.factored_inertia = inertia_coefficients(p);
                         let t = Instant::now();
                         self.correct_for_rank_one();
                         let mut delta = r;
@@ -276,6 +296,16 @@ impl CoupledSolver {
         self.system.fill(&locals);
         for (part, local) in parts.iter_mut().zip(locals) {
             part.local = local;
+        }
+        // Within a time step each body's tangent gains its `c M` (diagonal).
+        if let Some(inertia) = p.inertia {
+            for ((b, part), term) in parts.iter().enumerate().zip(inertia) {
+                let offset = self.system.offsets[b];
+                for (i, &dof) in part.dofs.free.iter().enumerate() {
+                    let g = offset + i;
+                    self.system.add(g, g, term.coefficient * term.mass[dof]);
+                }
+            }
         }
         self.rank_one.clear();
         for e in evaluated {
@@ -436,4 +466,12 @@ impl CoupledSolver {
             }
         }
     }
+}
+
+/// The inertia coefficient of each body in `p`, 1/s² (empty for a load step): a factor of the
+/// tangent serves another iteration only with the same ones.
+fn inertia_coefficients(p: &Problem) -> Vec<Real> {
+    p.inertia
+        .map(|i| i.iter().map(|t: &InertiaTerm| t.coefficient).collect())
+        .unwrap_or_default()
 }

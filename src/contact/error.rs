@@ -100,6 +100,28 @@ pub enum ContactError {
         /// loads pressing it on them.
         capacity: Real,
     },
+    /// A time step was given another number of inertia terms than there are bodies.
+    #[error("a time step was given {terms} inertia terms for {bodies} bodies: give one per body, in scene order")]
+    InertiaCount {
+        /// Inertia terms given.
+        terms: usize,
+        /// Bodies.
+        bodies: usize,
+    },
+    /// A body's inertia term does not fit it.
+    #[error("body '{body}': its inertia term for the time step is unusable ({problem}): give one mass (kg, at least 0) and one predictor value (m) per body DOF, all finite, and a finite coefficient of at least 0 (1/s²)")]
+    Inertia {
+        /// Body name.
+        body: String,
+        /// What is wrong, with the DOF and node (1-based) where one is.
+        problem: String,
+    },
+    /// A time step's position along the loads' and obstacles' schedules is not finite.
+    #[error("a time step was asked for at pseudo-time {at}: it must be finite (step units of the schedules)")]
+    TimeStepPosition {
+        /// The pseudo-time given.
+        at: Real,
+    },
     /// The result is not finite.
     #[error("step {step}: the solution with contact is not finite: check the penalty ([contact] penalty) and the loads")]
     NotFinite {

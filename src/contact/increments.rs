@@ -95,7 +95,7 @@ impl ContactSolver {
             self.geometry
                 .record_crossings(bodies, &self.parts, &self.active, offsets_there);
             self.extrapolate(bodies, obstacles, t1, steps, step);
-            match self.settle(bodies, obstacles, t1, steps, step) {
+            match self.settle(bodies, obstacles, (t1, steps), step, None) {
                 Ok(done) => {
                     out.contact_iterations += done.contact_iterations;
                     out.newton_iterations += done.newton_iterations;
@@ -169,7 +169,7 @@ impl ContactSolver {
         let offsets_there = obstacles.iter().map(|o| o.offset_at(from, steps)).collect();
         self.geometry
             .record_crossings(bodies, &self.parts, &self.active, offsets_there);
-        self.settle(bodies, obstacles, t, steps, step)
+        self.settle(bodies, obstacles, (t, steps), step, None)
     }
 
     /// Start the converged path over from the current state at the step solved: after members
@@ -204,6 +204,7 @@ impl ContactSolver {
             move_cap: self.move_cap,
             force_floor: self.force_floor(),
             friction: self.friction.as_ref(),
+            inertia: None,
         }
     }
 
@@ -272,7 +273,7 @@ impl ContactSolver {
     /// active contact's tangential force and slip, the displacements and obstacle offsets
     /// (relative motion is measured from here on). A contact no longer active forgets its
     /// history.
-    fn commit_friction(
+    pub(crate) fn commit_friction(
         &mut self,
         bodies: &[Body],
         obstacles: &[Obstacle],

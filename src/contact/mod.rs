@@ -48,3 +48,4 @@ mod settle;
 mod start;
 mod surface;
 mod ties;
+mod time_step;

@@ -139,7 +139,15 @@ pub(crate) fn finish(
         .zip(touched)
         .enumerate()
         .map(|(b, ((body, fc), contacts))| {
-            body_report(p, &parts[b], body, &forces[b], fc, contacts, iterations)
+            body_report(
+                p,
+                (b, &parts[b]),
+                body,
+                &forces[b],
+                fc,
+                contacts,
+                iterations,
+            )
         })
         .collect();
     for report in each {
@@ -154,11 +162,11 @@ pub(crate) fn finish(
 /// One body's part of the report: its totals per pair, its state and its contacts.
 type BodyReport = (Vec<(String, Vector3<Real>)>, StepState, Vec<NodeContact>);
 
-/// The report of one body (`part` of `body`, applied `forces`, contact forces `fc` per DOF,
+/// The report of one body (`part` of `body`, number `b`, applied `forces`, contact forces `fc` per DOF,
 /// the nodes it touches with) after `iterations` Newton iterations.
 fn body_report(
     p: &Problem,
-    part: &BodyPart,
+    (b, part): (usize, &BodyPart),
     body: &Body,
     forces: &[Real],
     fc: Vec<Real>,
@@ -170,6 +178,11 @@ fn body_report(
     let mut internal = internal_force_vector(body, &part.u);
     for (i, f) in internal.iter_mut().zip(&fc) {
         *i -= f;
+    }
+    // Within a time step the inertia force balances the rest: at a free DOF it is part of the
+    // residual's balance, at a held one part of the reaction (the support moves the mass).
+    if let Some(term) = p.inertia.and_then(|i| i.get(b)) {
+        term.add_force(&part.u, &mut internal);
     }
     let members = (0..body.members.len()).map(|m| {
         let r = member_response_at(body, &part.u, m);

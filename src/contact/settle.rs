@@ -12,6 +12,7 @@ use crate::contact::{
     ContactSettings, FrictionHistory, Obstacle, Penalty, Target,
 };
 use crate::linkage::body_state::{loads_at, node_vector, prescribed_at};
+use crate::linkage::dynamics::InertiaTerm;
 use crate::linkage::{
     Body, Convergence, DofMap, Mechanism, PathMethod, PhaseTimes, SolveError, SolverUsed,
     StiffnessAssembly,
@@ -84,6 +85,8 @@ pub(crate) struct Problem<'a> {
     pub(crate) force_floor: Real,
     /// Friction and its history (`None`: every pair frictionless).
     pub(crate) friction: Option<&'a FrictionHistory>,
+    /// Per body, the inertia term of a time step (`None`: a load step, no inertia).
+    pub(crate) inertia: Option<&'a [InertiaTerm]>,
 }
 
 impl Problem<'_> {
@@ -187,6 +190,10 @@ pub struct ContactSolver {
     pub(crate) normals: HashMap<ActiveContact, Vector3<Real>>,
     /// The step the displacements belong to.
     pub(crate) step: usize,
+    /// Time steps solved ([`ContactSolver::solve_time_step`]; messages name them).
+    pub(crate) time_steps: usize,
+    /// The pseudo-time of the last time step solved (step units; 0 before the first).
+    pub(crate) time_at: Real,
     /// Largest nodal move of a stabilised iteration, m: the smallest mean member length.
     pub(crate) move_cap: Real,
     /// The last converged states (pseudo-time, displacements per body), newest last, at most
@@ -215,13 +222,29 @@ impl ContactSolver {
         obstacles: &[Obstacle],
         settings: ContactSettings,
     ) -> Result<Self, ContactError> {
+        ContactSolver::build(bodies, obstacles, settings, false)
+    }
+
+    /// [`ContactSolver::new`], for bodies with inertia (`with_inertia`: they need no
+    /// supports) or without.
+    pub(crate) fn build(
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        settings: ContactSettings,
+        with_inertia: bool,
+    ) -> Result<Self, ContactError> {
         let t = Instant::now();
         one_dimension(bodies)?;
         let mut parts = Vec::with_capacity(bodies.len());
         let mut node_offsets = Vec::with_capacity(bodies.len());
         let mut nodes = 0;
         for body in bodies {
-            body.validate().map_err(SolveError::from)?;
+            if with_inertia {
+                body.validate_with_inertia()
+            } else {
+                body.validate()
+            }
+            .map_err(SolveError::from)?;
             if let PathMethod::ArcLength { .. } = body.newton.path {
                 return Err(ContactError::ArcLength {
                     body: body.name.clone(),
@@ -315,6 +338,8 @@ impl ContactSolver {
             active: ContactSet::default(),
             normals: HashMap::new(),
             step: 0,
+            time_steps: 0,
+            time_at: 0.0,
             path: vec![(
                 0.0,
                 bodies.iter().map(|b| vec![0.0; b.dof_count()]).collect(),
@@ -409,9 +434,9 @@ impl ContactSolver {
         &mut self,
         bodies: &[Body],
         obstacles: &[Obstacle],
-        t: Real,
-        steps: usize,
+        (t, steps): (Real, usize),
         step: usize,
+        inertia: Option<&[InertiaTerm]>,
     ) -> Result<ContactStep, ContactError> {
         let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
         let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
@@ -427,7 +452,8 @@ impl ContactSolver {
         let mut refinements = 0;
         loop {
             out.contact_iterations += 1;
-            let (iterations, settled) = self.newton(bodies, &set, &forces, &offsets, step)?;
+            let (iterations, settled) =
+                self.newton(bodies, &set, (&forces, &offsets), step, inertia)?;
             out.newton_iterations += iterations;
             out.stabilised |= !settled;
             let mut found = self.look(bodies, &set, &offsets);
@@ -496,9 +522,23 @@ impl ContactSolver {
         obstacles: &[Obstacle],
         step: usize,
         steps: usize,
+        out: ContactStep,
+    ) -> Result<ContactStep, ContactError> {
+        self.report_at(bodies, obstacles, (step as Real, steps), step, None, out)
+    }
+
+    /// The report of the settled state at pseudo-time `t` of `steps` (named `step` in
+    /// messages) into `out`, with the bodies' `inertia` in their balance (a time step) or
+    /// without (`None`: a load step).
+    pub(crate) fn report_at(
+        &mut self,
+        bodies: &[Body],
+        obstacles: &[Obstacle],
+        (t, steps): (Real, usize),
+        step: usize,
+        inertia: Option<&[InertiaTerm]>,
         mut out: ContactStep,
     ) -> Result<ContactStep, ContactError> {
-        let t = step as Real;
         let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
         let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
         let (tolerance, max_iterations) = newton_limits(bodies);
@@ -519,6 +559,7 @@ impl ContactSolver {
                 self.largest_force_scale
             }),
             friction: self.friction.as_ref(),
+            inertia,
         };
         let evaluated = problem.evaluate(&mut self.normals, &self.parts);
         out.negative_pivots = self.coupled.negative_pivots;
@@ -550,9 +591,9 @@ impl ContactSolver {
         &mut self,
         bodies: &[Body],
         set: &ContactSet,
-        forces: &[Vec<Real>],
-        offsets: &[Vector3<Real>],
+        (forces, offsets): (&[Vec<Real>], &[Vector3<Real>]),
         step: usize,
+        inertia: Option<&[InertiaTerm]>,
     ) -> Result<(usize, bool), ContactError> {
         let (tolerance, max_iterations) = newton_limits(bodies);
         let problem = Problem {
@@ -567,6 +608,7 @@ impl ContactSolver {
             move_cap: self.move_cap,
             force_floor: self.force_floor(),
             friction: self.friction.as_ref(),
+            inertia,
         };
         if let Some(condensed) = self.condensed.as_mut() {
             let done = condensed.newton(

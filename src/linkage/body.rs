@@ -340,6 +340,17 @@ impl Body {
 
     /// Check everything that can be checked before solving; the first problem found is returned.
     pub fn validate(&self) -> Result<(), BodyError> {
+        self.validate_held(true)
+    }
+
+    /// [`Body::validate`] for a body with inertia (a time step): it needs no supports, its
+    /// mass holds it (a body may fly free).
+    pub fn validate_with_inertia(&self) -> Result<(), BodyError> {
+        self.validate_held(false)
+    }
+
+    /// [`Body::validate`], with the supports required (`needs_supports`) or not.
+    fn validate_held(&self, needs_supports: bool) -> Result<(), BodyError> {
         let body = || self.name.clone();
         for m in &self.materials {
             if let Some(problem) = m.problem() {
@@ -419,7 +430,7 @@ impl Body {
                 node: n + 1,
             });
         }
-        if self.supports.iter().all(|s| !s.fixed.iter().any(|f| *f)) {
+        if needs_supports && self.supports.iter().all(|s| !s.fixed.iter().any(|f| *f)) {
             return Err(BodyError::NoSupports { body: body() });
         }
         for (i, s) in self.supports.iter().enumerate() {
