@@ -931,3 +931,42 @@ fn an_area_of_1e_minus_308_overflows_and_is_refused_not_written_as_null() {
     };
     check_output(dir.path(), &files, &outcome).unwrap();
 }
+
+/// Found by the fuzzing (10,000 cases, case 3,000 or so): `half_extents = [0.15, 0.1,
+/// 9223372036854775807]` on `shell_on_block.toml`'s block (within the ±1e100 m bound) made
+/// contact sample the cuboid's sharp edges at half the shell's shortest member: about 1e20
+/// points, an allocation of 6 GB and more that aborted the process (the fuzz run was killed by
+/// the kernel at 19 GB). It is now an input error at the line of `half_extents`, naming the
+/// obstacle, before anything is allocated; the bundled block itself is accepted.
+#[test]
+fn a_cuboid_of_9e18_m_is_refused_before_its_edges_are_sampled() {
+    let scenes = bundled_scenes();
+    let scene = scenes
+        .iter()
+        .find(|s| s.file == "shell_on_block.toml")
+        .unwrap();
+    let text = scene.text.replace(
+        "half_extents = [0.15, 0.1, 0.3]",
+        "half_extents = [0.15, 0.1, 9223372036854775807]",
+    );
+    assert_ne!(text, scene.text);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(&scene.file);
+    std::fs::write(&path, &text).unwrap();
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("half_extents"))
+        .unwrap()
+        + 1;
+    let message = load_scene(&path).unwrap_err().to_string();
+    for part in [
+        &format!("shell_on_block.toml:{line}: obstacle '"),
+        "`half_extents` makes its sharp edges",
+        "points allowed",
+        "sizes of the scene's scale",
+    ] {
+        assert!(message.contains(part), "{part:?} in {message}");
+    }
+    std::fs::write(&path, &scene.text).unwrap();
+    assert!(load_scene(&path).is_ok());
+}

@@ -10,6 +10,7 @@ pub use self::friction::{
 };
 pub use self::mesh_orientation::{orient_outward, MeshProblem, Orientation};
 pub use self::obstacle::{Obstacle, ObstacleShape};
+pub use self::obstacle_features::{sharp_sample_estimate, MAX_SHARP_SAMPLES, SAMPLE_SPACING};
 pub use self::obstacles::{mesh_collider, primitive_collider, ObstacleProjection, Obstacles};
 pub use self::patch_surface::{PatchSurface, SurfaceProblem};
 pub use self::penalty::{default_penalty, penetration_tolerance, Penalty, PENALTY_FACTOR};

@@ -24,6 +24,40 @@ pub const SHARP_ANGLE: Real = std::f64::consts::FRAC_PI_6;
 /// Points along sharp edges are at most this fraction of the shortest member apart.
 pub const SAMPLE_SPACING: Real = 0.5;
 
+/// More points than this along an obstacle's sharp edges are refused before any is made (240 MB
+/// of points): an obstacle sized far beyond its bodies (a cuboid 1e19 m long) would need them.
+pub const MAX_SHARP_SAMPLES: Real = 1e7;
+
+/// How many points the sharp edges of `shape` take at [`SAMPLE_SPACING`] × `shortest` (the
+/// bodies' shortest member, m), estimated from its edge lengths before any point is made: a
+/// cuboid's 12 edges, `8 (a + b + c)` for half extents a, b, c; a cylinder's two rims, `4 π r`;
+/// a mesh's edges, half the sum of its triangles' perimeters (every edge a sharp one at most);
+/// 0 for the smooth shapes.
+pub fn sharp_sample_estimate(shape: &ObstacleShape, shortest: Real) -> Real {
+    let length = match shape {
+        ObstacleShape::Cuboid { half_extents, .. } => {
+            8.0 * (half_extents.x.abs() + half_extents.y.abs() + half_extents.z.abs())
+        }
+        ObstacleShape::Cylinder { radius, .. } => 2.0 * std::f64::consts::TAU * radius.abs(),
+        ObstacleShape::Mesh {
+            vertices,
+            triangles,
+        } => {
+            let edge = |a: usize, b: usize| match (vertices.get(a), vertices.get(b)) {
+                (Some(p), Some(q)) => (p - q).norm(),
+                _ => 0.0,
+            };
+            triangles
+                .iter()
+                .map(|t| edge(t[0], t[1]) + edge(t[1], t[2]) + edge(t[2], t[0]))
+                .sum::<Real>()
+                / 2.0
+        }
+        _ => 0.0,
+    };
+    length / (SAMPLE_SPACING * shortest)
+}
+
 /// Where and along which normal a node entered a polyhedral obstacle, in the obstacle's frame at
 /// the start of its travel (world coordinates minus the obstacle's offset).
 #[derive(Clone, Copy, Debug, PartialEq)]

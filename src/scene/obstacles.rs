@@ -1,7 +1,10 @@
 //! Building the scene's rigid obstacles and contact settings from `[[obstacles]]` and
 //! `[contact]`.
 
-use crate::contact::{mesh_collider, orient_outward, ContactSettings, Obstacle, ObstacleShape};
+use crate::contact::{
+    mesh_collider, orient_outward, sharp_sample_estimate, ContactSettings, Obstacle, ObstacleShape,
+    MAX_SHARP_SAMPLES, SAMPLE_SPACING,
+};
 use crate::linkage::{Body, Dimension, Schedule};
 use crate::scene::bounds::{check_length, check_lengths, check_rotation};
 use crate::scene::mesh_file::read_mesh;
@@ -177,6 +180,27 @@ pub(crate) fn obstacle_from(
             Schedule::Factors(f.clone())
         }
     };
+    // Contact samples a 3D obstacle's sharp edges at half the bodies' shortest member: one far
+    // larger than the bodies would need more points than memory holds.
+    let shortest = bodies
+        .iter()
+        .flat_map(|b| (0..b.members.len()).map(|m| b.member_length(m)))
+        .fold(Real::INFINITY, Real::min);
+    if dimension == Dimension::Three && shortest.is_finite() && shortest > 0.0 {
+        let samples = sharp_sample_estimate(&shape, shortest);
+        if samples.is_nan() || samples > MAX_SHARP_SAMPLES {
+            let key = match spec.shape.as_str() {
+                "mesh" => "file",
+                "cylinder" => "radius",
+                _ => "half_extents",
+            };
+            return Err(fail(format!(
+                "`{key}` makes its sharp edges {:.3e} m long in all, {samples:.3e} times the spacing contact samples them at ({:.3e} m, {SAMPLE_SPACING} of the bodies' shortest member): more than the {MAX_SHARP_SAMPLES:e} points allowed; give the obstacle sizes of the scene's scale (an endless floor is a half_space)",
+                samples * SAMPLE_SPACING * shortest,
+                SAMPLE_SPACING * shortest,
+            )));
+        }
+    }
     Ok((
         Obstacle {
             name: name.clone(),
