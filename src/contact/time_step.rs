@@ -163,15 +163,15 @@ fn check_inertia(bodies: &[Body], inertia: &[InertiaTerm]) -> Result<(), Contact
                 i % body.dimension.dofs_per_node() + 1,
                 i / body.dimension.dofs_per_node() + 1
             ))
-        } else if let Some(i) = term.predictor.iter().position(|p| !p.is_finite()) {
-            Some(format!(
-                "predictor {:e} m at DOF {} of node {}",
-                term.predictor[i],
-                i % body.dimension.dofs_per_node() + 1,
-                i / body.dimension.dofs_per_node() + 1
-            ))
         } else {
-            None
+            term.predictor.iter().position(|p| !p.is_finite()).map(|i| {
+                format!(
+                    "predictor {:e} m at DOF {} of node {}",
+                    term.predictor[i],
+                    i % body.dimension.dofs_per_node() + 1,
+                    i / body.dimension.dofs_per_node() + 1
+                )
+            })
         };
         if let Some(problem) = problem {
             return Err(ContactError::Inertia {
