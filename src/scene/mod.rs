@@ -5,7 +5,7 @@ pub use self::check::{
     check_world, obstacle_offset_bytes, output_warning, step_file_bytes, stored_steps, CheckReport,
     BYTES_PER_VALUE, NPZ_BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
 };
-pub use self::driver::{run, run_into, run_until, run_with};
+pub use self::driver::{run, run_into, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::plot_settings::{PlotNode, PlotSettings};
@@ -17,7 +17,7 @@ pub use self::results::{
 };
 pub use self::run_error::RunError;
 pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS};
-pub use self::scene_digest::scene_digest;
+pub use self::scene_digest::{scene_and_files_digest, scene_digest};
 pub use self::selector::select_nodes;
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
@@ -31,6 +31,7 @@ pub mod atomic_file;
 pub mod batch;
 mod bounds;
 mod build;
+pub mod capacity;
 mod check;
 mod contact_pairs;
 mod driver;
