@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 /// or failed (after writing the table of those there).
 pub fn collect(dir: &Path) -> Result<()> {
     let c = batch::collect(dir)?;
-    println!(
+    say!(
         "wrote {}: {} rows from {} of {} parts",
         dir.join(batch::TABLE).display(),
         c.rows,
@@ -23,15 +23,13 @@ pub fn collect(dir: &Path) -> Result<()> {
     if linkage::render::report::has_pictures(dir, &rows) {
         let page = linkage::render::report::write_report(dir, &rows)
             .with_context(|| format!("cannot write the report in {}", dir.display()))?;
-        println!("report {}", page.display());
+        say!("report {}", page.display());
     }
     for job in &c.missing {
-        println!(
-            "missing  {job}: its shard did not finish; run it again (complete jobs are skipped)"
-        );
+        say!("missing  {job}: its shard did not finish; run it again (complete jobs are skipped)");
     }
     for (job, status) in &c.failed {
-        println!("FAIL  {job}: {status}");
+        say!("FAIL  {job}: {status}");
     }
     if !c.missing.is_empty() || !c.failed.is_empty() {
         bail!(
@@ -50,14 +48,14 @@ pub fn slurm(scenes: &[PathBuf], out: &Path, options: SlurmOptions) -> Result<()
         .with_context(|| format!("cannot create the output folder {}", out.display()))?;
     let exe = std::env::current_exe().context("cannot tell where this linkage program is")?;
     let plan = batch::write_slurm(&exe, scenes, out, jobs.len(), &options)?;
-    println!(
+    say!(
         "wrote {} ({} jobs in {} array tasks) and {}",
         plan.script.display(),
         plan.jobs,
         plan.tasks,
         plan.collect_script.display()
     );
-    println!("submit the array, and the collect job to run after it:");
-    println!("  {}", plan.submit);
+    say!("submit the array, and the collect job to run after it:");
+    say!("  {}", plan.submit);
     Ok(())
 }

@@ -11,26 +11,26 @@ pub(crate) fn bench_contact(
 ) -> Result<()> {
     let cells = cells.first().copied().unwrap_or([45, 45, 45]);
     let solver = if direct { "direct" } else { "iterative" };
-    println!("3D box lattice on a fixed floor pressed 2 mm by a ball obstacle ({solver} solver)");
+    say!("3D box lattice on a fixed floor pressed 2 mm by a ball obstacle ({solver} solver)");
     let t = linkage::bench::contact::measure_contact(cells, steps.unwrap_or(2), solver)
         .map_err(anyhow::Error::msg)?;
     for s in &t.steps {
-        println!("{}", linkage::bench::contact::format_step(s));
+        say!("{}", linkage::bench::contact::format_step(s));
     }
-    println!("{}", linkage::bench::contact::format_summary(&t));
+    say!("{}", linkage::bench::contact::format_summary(&t));
     Ok(())
 }
 
 pub(crate) fn bench_fracture(cells: Vec<[usize; 3]>, breaks: Option<usize>) -> Result<()> {
     let cells = cells.first().copied().unwrap_or([20, 20, 20]);
     let breaks = breaks.unwrap_or(1000);
-    println!("3D box lattice pulled at its top face, members breaking one after another in one load step");
+    say!("3D box lattice pulled at its top face, members breaking one after another in one load step");
     let t = linkage::bench::fracture::measure_fracture(cells, breaks, 10)
         .map_err(anyhow::Error::msg)?;
-    println!("{}", linkage::bench::fracture::format_fracture(&t));
+    say!("{}", linkage::bench::fracture::format_fracture(&t));
     let split =
         linkage::bench::fracture::measure_solve_split(cells, 20).map_err(anyhow::Error::msg)?;
-    println!("{}", linkage::bench::fracture::format_solve_split(&split));
+    say!("{}", linkage::bench::fracture::format_solve_split(&split));
     Ok(())
 }
 
@@ -59,13 +59,13 @@ pub(crate) fn bench_large(
         (true, false) => "multigrid conjugate gradients, warm-started",
         (true, true) => "multigrid conjugate gradients, cold starts",
     };
-    println!("3D column lattice, bottom clamped, top pushed sideways; large displacements by Newton ({how})");
+    say!("3D column lattice, bottom clamped, top pushed sideways; large displacements by Newton ({how})");
     let t = linkage::bench::large::measure_large(cells, force, steps, solver)
         .map_err(anyhow::Error::msg)?;
     for s in &t.steps {
-        println!("{}", linkage::bench::large::format_step(s));
+        say!("{}", linkage::bench::large::format_step(s));
     }
-    println!("{}", linkage::bench::large::format_summary(&t));
+    say!("{}", linkage::bench::large::format_summary(&t));
     Ok(())
 }
 
@@ -96,20 +96,20 @@ pub(crate) fn bench(
     } else {
         "direct sparse Cholesky (METIS order)"
     };
-    println!("3D box lattices: 26-neighbour cells, bottom face fixed, top face loaded; {what}");
+    say!("3D box lattices: 26-neighbour cells, bottom face fixed, top face loaded; {what}");
     if iterative {
-        println!("{}", linkage::bench::lattice::ITERATIVE_HEADER);
+        say!("{}", linkage::bench::lattice::ITERATIVE_HEADER);
     } else {
-        println!("{}", linkage::bench::lattice::HEADER);
+        say!("{}", linkage::bench::lattice::HEADER);
     }
     for c in sizes {
         if in_process && iterative {
             let t = linkage::bench::lattice::measure_iterative(c, !jacobi)
                 .map_err(anyhow::Error::msg)?;
-            println!("{}", linkage::bench::lattice::format_iterative_row(&t));
+            say!("{}", linkage::bench::lattice::format_iterative_row(&t));
         } else if in_process {
             let t = linkage::bench::lattice::measure_lattice(c).map_err(anyhow::Error::msg)?;
-            println!("{}", linkage::bench::lattice::format_row(&t));
+            say!("{}", linkage::bench::lattice::format_row(&t));
         } else {
             // One child per size, so the peak memory column is that size's own.
             let exe = std::env::current_exe().context("cannot find the linkage executable")?;
@@ -133,7 +133,7 @@ pub(crate) fn bench(
             }
             let text = String::from_utf8_lossy(&output.stdout);
             if let Some(row) = text.lines().last() {
-                println!("{row}");
+                say!("{row}");
             }
         }
     }
@@ -142,10 +142,8 @@ pub(crate) fn bench(
 
 pub(crate) fn bench_read(cells: Vec<[usize; 3]>) -> Result<()> {
     let dir = tempfile_dir("linkage-bench-read")?;
-    println!(
-        "Reading the paper's files of a box lattice (links with a material column), best of 3"
-    );
-    println!(
+    say!("Reading the paper's files of a box lattice (links with a material column), best of 3");
+    say!(
         "{:>12} {:>8} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8}",
         "cells",
         "nodes",
@@ -164,7 +162,7 @@ pub(crate) fn bench_read(cells: Vec<[usize; 3]>) -> Result<()> {
     };
     let measured = sizes.into_iter().try_for_each(|c| -> Result<()> {
         let t = linkage::bench::read::measure_read(c, &dir, 3).map_err(anyhow::Error::msg)?;
-        println!(
+        say!(
             "{:>12} {:>8} {:>9} {:>9.1} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.1}",
             format!("{}x{}x{}", c[0], c[1], c[2]),
             t.nodes,
@@ -238,8 +236,8 @@ fn run_lattice_scene(c: [usize; 3], dir: &std::path::Path) -> Result<()> {
     let p = &summary.phases;
     let [nodes, members, _] = files.counts;
     let links_mb = std::fs::metadata(&files.links).map_or(0, |m| m.len()) as f64 / 1e6;
-    println!("A box lattice through `linkage run` (paper's files, multigrid solver, 1 load step), in a child process");
-    println!(
+    say!("A box lattice through `linkage run` (paper's files, multigrid solver, 1 load step), in a child process");
+    say!(
         "{:>10} {:>8} {:>9} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8}",
         "cells",
         "nodes",
@@ -253,7 +251,7 @@ fn run_lattice_scene(c: [usize; 3], dir: &std::path::Path) -> Result<()> {
         "wall s",
         "peak MB"
     );
-    println!(
+    say!(
         "{:>10} {:>8} {:>9} {:>9.1} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.0}",
         format!("{}x{}x{}", c[0], c[1], c[2]),
         nodes,
@@ -267,7 +265,7 @@ fn run_lattice_scene(c: [usize; 3], dir: &std::path::Path) -> Result<()> {
         wall,
         peak as f64 / 1e6
     );
-    println!("(set-up: the matrix in full rows and the multigrid hierarchy; solve: conjugate gradients; peak: the child's largest resident set, MB of 10^6 bytes)");
+    say!("(set-up: the matrix in full rows and the multigrid hierarchy; solve: conjugate gradients; peak: the child's largest resident set, MB of 10^6 bytes)");
     Ok(())
 }
 
@@ -293,12 +291,16 @@ fn tempfile_dir(prefix: &str) -> Result<PathBuf> {
 pub(crate) fn bench_render(patches: usize, size: [u32; 2]) -> Result<()> {
     let t = linkage::bench::render::render_benchmark(patches, size[0], size[1], 3)
         .map_err(anyhow::Error::msg)?;
-    println!("Rendering: one frame of a bent cylindrical shell, shaded and stress-coloured (supersampling 2x2), best of 3");
-    println!(
+    say!("Rendering: one frame of a bent cylindrical shell, shaded and stress-coloured (supersampling 2x2), best of 3");
+    say!(
         "{:>9} {:>9} {:>11} {:>10} {:>10}",
-        "patches", "members", "pixels", "draw s", "PNG s"
+        "patches",
+        "members",
+        "pixels",
+        "draw s",
+        "PNG s"
     );
-    println!(
+    say!(
         "{:>9} {:>9} {:>11} {:>10.3} {:>10.3}",
         t.patches,
         t.members,
@@ -311,21 +313,23 @@ pub(crate) fn bench_render(patches: usize, size: [u32; 2]) -> Result<()> {
 
 pub(crate) fn bench_gif(dir: &Path) -> Result<()> {
     let t = linkage::bench::render::gif_benchmark(dir).map_err(anyhow::Error::msg)?;
-    println!(
+    say!(
         "GIF of {} ({} frames of 1280x720, drawn in {:.3} s):",
         dir.display(),
         t.frames,
         t.draw
     );
-    println!(
+    say!(
         "  a palette per frame (NeuQuant), sequential: {:.3} s, {} bytes",
-        t.per_frame_palette, t.bytes.0
+        t.per_frame_palette,
+        t.bytes.0
     );
-    println!(
+    say!(
         "  one palette for the run, frames in parallel: {:.3} s, {} bytes",
-        t.shared_palette, t.bytes.1
+        t.shared_palette,
+        t.bytes.1
     );
-    println!(
+    say!(
         "  speed-up: {:.1}x",
         t.per_frame_palette / t.shared_palette.max(1e-12)
     );
@@ -335,12 +339,12 @@ pub(crate) fn bench_gif(dir: &Path) -> Result<()> {
 pub(crate) fn bench_prepare() -> Result<()> {
     use linkage::bench::prepare::{measure_prepare, RADIUS, SPACING, TUBE};
     let t = measure_prepare(SPACING).map_err(anyhow::Error::msg)?;
-    println!(
+    say!(
         "Preparing a torus (radius {RADIUS} m, tube {TUBE} m, {} triangles) at spacing {SPACING} m: isosurface stuffing",
         t.triangles
     );
-    println!("{}", t.report);
-    println!(
+    say!("{}", t.report);
+    say!(
         "prepare {:.3} s, peak memory {:.0} MB",
         t.seconds,
         t.peak_memory as f64 / 1e6
@@ -376,13 +380,13 @@ pub(crate) fn bench_cholmod(
         linkage::scene::atomic_file::write_atomically(&script, COMPARE_SCRIPT.as_bytes())
             .with_context(|| format!("writing {}", script.display()))?;
         let load = |l: Option<f64>| l.map_or("?".to_string(), |l| format!("{l:.2}"));
-        println!(
+        say!(
             "Direct solve of the same K_ff: ours (METIS on the node graph, faer, {} threads) \
              against CHOLMOD (scikit-sparse, METIS, supernodal), alternately, best of {reps}",
             rayon::current_num_threads()
         );
-        println!("load average at start: {}", load(load_average()));
-        println!(
+        say!("load average at start: {}", load(load_average()));
+        say!(
             "{:<10} {:>3} {:>9} | {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} | {:>8} {:>8} {:>8} {:>8} {:>7} {:>8} | {:>6} {:>5}",
             "cells", "rep", "free DOFs",
             "analyze", "factor", "solve", "total", "CPU", "resid",
@@ -415,7 +419,7 @@ pub(crate) fn bench_cholmod(
                             true => (second, first),
                             false => (first, second),
                         };
-                        println!(
+                        say!(
                             "{name}: analysis: ordering {kept} kept, {:.4e} flops (nnz(L) {}) \
                              against {other}'s {:.4e} ({}) on the node graph; supernodal flops {}",
                             o.chosen.flops,
@@ -426,7 +430,7 @@ pub(crate) fn bench_cholmod(
                         );
                     }
                 }
-                println!(
+                say!(
                     "{:<10} {:>3} {:>9} | {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>6.2}s {:>8.1e} | {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>6.2}s {:>8.1e} | {:>6.3} {:>5}",
                     name, rep, system.n,
                     ours.analyze, ours.factor, ours.solve, ours.total(), ours.cpu, ours.residual,
@@ -434,7 +438,7 @@ pub(crate) fn bench_cholmod(
                     ours.total() / theirs.total(),
                     load(load_average())
                 );
-                println!(
+                say!(
                     "{:<10} {:>3} {:>9} | {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>6.2}s {:>8.1e} | faer's own supernode loop: {:.3} of CHOLMOD",
                     "", "", "",
                     plain.analyze, plain.factor, plain.solve, plain.total(), plain.cpu, plain.residual,
@@ -461,13 +465,13 @@ pub(crate) fn bench_cholmod(
                 }
             }
             if let (Some(p), Some(t)) = (plain_best, theirs_best.as_ref()) {
-                println!(
+                say!(
                     "{name}: best with faer's own supernode loop {:.3} s (analyze {:.3} + factor {:.3} + solve {:.3}): ratio {:.3}",
                     p.total(), p.analyze, p.factor, p.solve, p.total() / t.total()
                 );
             }
             if let (Some(o), Some(t)) = (ours_best, theirs_best) {
-                println!(
+                say!(
                     "{name}: best ours {:.3} s (analyze {:.3} + factor {:.3} + solve {:.3}), \
                      best CHOLMOD {:.3} s (analyze {:.3} + factor {:.3} + solve {:.3}): \
                      ratio {:.3}; factor+solve alone {:.3}; nnz(L) ours {} CHOLMOD {}",
@@ -486,7 +490,7 @@ pub(crate) fn bench_cholmod(
                 );
             }
         }
-        println!("load average at end: {}", load(load_average()));
+        say!("load average at end: {}", load(load_average()));
         Ok(())
     })();
     let _ = std::fs::remove_dir_all(&dir);

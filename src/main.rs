@@ -1,5 +1,14 @@
 //! The `linkage` command line: thin; it parses arguments and calls the library.
 
+/// `println!` that never panics: a closed stdout (`linkage run ... | head -1`) drops the line,
+/// and the command goes on to write its results in full, as it would with stdout open.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout().lock(), $($t)*);
+    }};
+}
+
 mod batch_cli;
 mod bench_cli;
 
@@ -10,6 +19,7 @@ use bench_cli::{
 };
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
+use linkage::linkage::Interrupt;
 use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
 use linkage::scene::batch::{self, JobSettings, Ran, SlurmOptions};
 use linkage::scene::load_scene;
@@ -296,11 +306,14 @@ fn parse_cells(s: &str) -> Result<[usize; 3], String> {
     Ok(out)
 }
 
-/// Set by SIGINT or SIGTERM: every run stops before its next step and removes its staging
-/// folder (a second signal exits at once; the next run removes what that leaves).
+/// Set by SIGINT or SIGTERM: every run stops where it is (between Newton and contact
+/// iterations, fracture events, steps, frames and writers; see `Interrupt`) and removes its
+/// staging folder; jobs not started do not start. A second signal exits at once (the next run
+/// removes the staging folders that leaves).
 static STOP: AtomicBool = AtomicBool::new(false);
 
-/// Exit status of a run stopped by a signal (128 + SIGINT, as shells report it).
+/// Exit status of a run stopped by a signal: 128 + SIGINT, as shells report an interrupted
+/// command, for SIGTERM too (the handler does not tell them apart).
 const INTERRUPTED: u8 = 130;
 
 fn main() -> ExitCode {
@@ -405,11 +418,13 @@ fn main() -> ExitCode {
             ..
         } => bench(cells, iterative, jacobi, in_process),
     };
+    let interrupted = STOP.load(Ordering::SeqCst);
     match outcome {
+        Ok(()) if interrupted => ExitCode::from(INTERRUPTED),
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
-            if STOP.load(Ordering::SeqCst) {
+            if interrupted {
                 ExitCode::from(INTERRUPTED)
             } else {
                 ExitCode::FAILURE
@@ -421,12 +436,16 @@ fn main() -> ExitCode {
 /// Make SIGINT and SIGTERM stop the runs cleanly (see [`STOP`]); without a handler the runs
 /// could not clean up, so say so and go on.
 fn catch_signals() {
+    // The handler runs on ctrlc's own thread, not in signal context, so it may print.
     if let Err(e) = ctrlc::set_handler(|| {
         if STOP.swap(true, Ordering::SeqCst) {
-            std::process::exit(i32::from(INTERRUPTED));
+            // At once: `_exit` runs no exit handlers and flushes nothing that the other
+            // threads, still solving or writing, may be using.
+            // SAFETY: `_exit` only ends the process; it has no preconditions.
+            unsafe { libc::_exit(i32::from(INTERRUPTED)) };
         }
         eprintln!(
-            "interrupted: stopping after the current step and removing partial results (again to quit at once)"
+            "interrupted: stopping now; no results of unfinished runs are kept (earlier results stay as they were); again to quit at once"
         );
     }) {
         eprintln!("warning: cannot catch SIGINT/SIGTERM ({e}): an interrupted run may leave a staging folder, removed by the next run");
@@ -502,7 +521,7 @@ fn run_scenes(
             Some(&PictureWriter),
             &on_start,
             &|| bar.inc(1),
-            &STOP,
+            Interrupt::on(&STOP),
         )
     };
     let work = || -> Vec<(Ran, batch::Row)> { mine.par_iter().map(one_job).collect() };
@@ -527,7 +546,11 @@ fn run_scenes(
             None => path.display().to_string(),
         };
         match ran {
-            Ran::Skipped => println!(
+            Ran::Drawn => say!(
+                "drew  {shown} -> {}: from the complete results there, without solving (--rerun solves it again)",
+                job.folder(out).display()
+            ),
+            Ran::Skipped => say!(
                 "skip  {shown} -> {}: complete results there (--rerun runs it again)",
                 job.folder(out).display()
             ),
@@ -537,7 +560,7 @@ fn run_scenes(
                 seconds,
             } => {
                 if let Some((_, first)) = written.iter().find(|(n, _)| *n == job.id()) {
-                    println!(
+                    say!(
                         "warn  {} and {} share the name '{}': {} holds whichever finished last",
                         first.display(),
                         path.display(),
@@ -547,7 +570,7 @@ fn run_scenes(
                 }
                 written.push((job.id(), path.clone()));
                 let last = summary.steps.last();
-                println!(
+                say!(
                     "ok    {shown} -> {}: {}; {:.3} s; max |u| {:.4e} m; {} overloaded; residual {:.1e}",
                     job.folder(out).display(),
                     world.describe_solved(summary.bodies.iter().map(|b| b.free_dofs).sum()),
@@ -557,7 +580,7 @@ fn run_scenes(
                     summary.steps.iter().map(|s| s.residual).fold(0.0, f64::max),
                 );
                 let p = &summary.phases;
-                println!(
+                say!(
                     "      phases: reading {:.3} s, assembly {:.3} s, ordering+symbolic {:.3} s, factorization {:.3} s, solve {:.3} s, contact_query {:.3} s, writing {:.3} s, drawing {:.3} s",
                     p.reading, p.assembly, p.symbolic, p.numeric, p.solve, p.contact_query, p.writing, p.drawing
                 );
@@ -565,18 +588,18 @@ fn run_scenes(
                 // enough to show here, not only in summary.json.
                 for step in &summary.steps {
                     for w in &step.warnings {
-                        println!("warn  {}: {w}", world.name);
+                        say!("warn  {}: {w}", world.name);
                     }
                 }
                 let teeth = summary.breaks.iter().filter(|b| b.tooth.is_some()).count();
                 if summary.breaks.len() > teeth {
-                    println!("      {} member(s) broke", summary.breaks.len() - teeth);
+                    say!("      {} member(s) broke", summary.breaks.len() - teeth);
                 }
                 if teeth > 0 {
-                    println!("      {teeth} softening tooth/teeth passed");
+                    say!("      {teeth} softening tooth/teeth passed");
                 }
                 if let Some(c) = &summary.collapse {
-                    println!(
+                    say!(
                         "      collapse: body '{}' at step {} (load factor {}): breaking member {} left its supported part a mechanism; steps 0-{} written",
                         c.body, c.step, c.load_factor, c.member, c.step.saturating_sub(1)
                     );
@@ -586,9 +609,9 @@ fn run_scenes(
                 failed += 1;
                 // Errors name their file; prefix the scene when they name another one.
                 if msg.starts_with(&path.display().to_string()) {
-                    println!("FAIL  {msg}");
+                    say!("FAIL  {msg}");
                 } else {
-                    println!("FAIL  {shown}: {msg}");
+                    say!("FAIL  {shown}: {msg}");
                 }
             }
         }
@@ -602,7 +625,7 @@ fn run_scenes(
     if shard.is_none() && (settings.png || linkage::render::report::has_pictures(out, &rows)) {
         let page = linkage::render::report::write_report(out, &rows)
             .with_context(|| format!("cannot write the report in {}", out.display()))?;
-        println!("report {}", page.display());
+        say!("report {}", page.display());
     }
     if failed > 0 {
         let noun = if mine.iter().any(|j| j.variant.is_some()) {
@@ -649,9 +672,9 @@ fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
                 // they name another one.
                 let msg = e.to_string();
                 if msg.starts_with(&path.display().to_string()) {
-                    println!("FAIL  {msg}");
+                    say!("FAIL  {msg}");
                 } else {
-                    println!("FAIL  {}: {msg}", shown.display());
+                    say!("FAIL  {}: {msg}", shown.display());
                 }
             }
         }
@@ -669,21 +692,27 @@ fn check_scenes(scenes: &[PathBuf]) -> Result<()> {
 /// The report of one scene that passed `linkage check`: its size, per body its sizes and
 /// solver, what only a run can tell, and warnings.
 fn print_check(path: &Path, report: &linkage::scene::CheckReport) {
-    println!("ok    {}: {}", path.display(), report.describe);
+    say!("ok    {}: {}", path.display(), report.describe);
     for b in &report.bodies {
-        println!(
+        say!(
             "      body '{}': {}D, {} nodes, {} members, {} patches, {} free DOFs, {} solver",
-            b.name, b.dimension, b.nodes, b.members, b.patches, b.free_dofs, b.solver
+            b.name,
+            b.dimension,
+            b.nodes,
+            b.members,
+            b.patches,
+            b.free_dofs,
+            b.solver
         );
     }
     for f in &report.found {
-        println!("      found: {f}");
+        say!("      found: {f}");
     }
     for note in &report.notes {
-        println!("      not checked: {note}");
+        say!("      not checked: {note}");
     }
     for w in &report.warnings {
-        println!("warn  {}: {w}", path.display());
+        say!("warn  {}: {w}", path.display());
     }
 }
 
@@ -696,9 +725,9 @@ fn prepare(input: &Path, spacing: f64, out: &Path) -> Result<()> {
     let written = linkage::scene::write_prepared(out, &stem, &body)
         .with_context(|| format!("cannot write the prepared body into {}", out.display()))?;
     for path in written {
-        println!("wrote {}", path.display());
+        say!("wrote {}", path.display());
     }
-    println!("{}", body.report);
+    say!("{}", body.report);
     Ok(())
 }
 
@@ -746,7 +775,7 @@ fn export(scene: &Path, out: &Path) -> Result<()> {
             write_patches(&path, &body.patches)
                 .with_context(|| format!("cannot write {}", path.display()))?;
         }
-        println!(
+        say!(
             "wrote {}: {} nodes, {} members, {} patches",
             file("*").display(),
             body.nodes.len(),
@@ -760,6 +789,7 @@ fn export(scene: &Path, out: &Path) -> Result<()> {
 fn render(a: &RenderArgs) -> Result<()> {
     use linkage::render::{render_run_to, RenderOptions};
     use linkage::scene::{write_vtk, RunResults, VtkEncoding};
+    catch_signals();
     // A published results folder always has its summary: without it the folder is not one.
     let summary = a.dir.join("summary.json");
     if !summary.is_file() {
@@ -782,6 +812,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         png: !a.no_png,
         gif: !a.no_gif,
         supersampling: a.supersampling,
+        interrupt: Interrupt::on(&STOP),
     };
     let out = a.out.clone().unwrap_or_else(|| a.dir.clone());
     if a.out.is_some() {
@@ -791,7 +822,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     let report = render_run_to(&a.dir, &out, &options)?;
     let seconds = t.elapsed().as_secs_f64();
     if options.png || options.gif {
-        println!(
+        say!(
             "drew {} step{} of {} in {:.2} s (displacements ×{}): {} PNG frame{} in {}{}",
             report.steps.len(),
             if report.steps.len() == 1 { "" } else { "s" },
@@ -816,7 +847,7 @@ fn render(a: &RenderArgs) -> Result<()> {
             VtkEncoding::Binary
         };
         let files = write_vtk(&run, &out, encoding)?;
-        println!(
+        say!(
             "wrote {} ParaView files in {}",
             files.len(),
             out.join("vtk").display()

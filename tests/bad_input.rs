@@ -866,3 +866,46 @@ fn huge_generated_or_offset_bodies_are_input_errors() {
         &["scene.toml:", "body 'g'", "`offset`", "beyond ±1e100 m"],
     );
 }
+
+#[test]
+fn absurd_step_counts_are_refused_before_anything_is_allocated() {
+    // 2^32 load steps: the summary lines alone would take some 1 TB of memory, the step files
+    // 54 TB of disk. Refused with the estimate and what the machine has; nothing is written.
+    let case = Case::new();
+    let text = format!(
+        "name = \"t\"\nsteps = 4294967296\n{MATERIAL}\n[[bodies]]\nname = \"sq\"\nnodes = \"s.nodes\"\nlinks = \"s.links\"\n[[bodies.supports]]\nnodes = [3]\nfix = [\"x\", \"y\"]\n[[bodies.supports]]\nnodes = [4]\nfix = [\"y\"]\n[[bodies.loads]]\nnodes = [2]\nforce = [200.0, 0.0]\n"
+    );
+    let scene = case.dir.path().join("huge.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = case.dir.path().join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_linkage"))
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{stdout}");
+    assert_has(
+        &stdout,
+        &["huge.toml", "GB of memory", "available", "fewer load steps"],
+    );
+    assert!(!out.join("t").exists());
+    let left: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+#[test]
+fn a_body_check_made_before_solving_points_at_the_key_not_the_body_header() {
+    // Node 5 belongs to no member: the error is about the links, so it names the line of
+    // `links = "s.links"` (line 10), not `[[bodies]]` (line 7).
+    let c = Case::new();
+    c.file("s.nodes", "1 1\n0 1\n0 0\n1 0\n2 2\n");
+    let e = c.error(SUPPORTS);
+    assert_has(&e, &["scene.toml:10:", "node 5"]);
+}

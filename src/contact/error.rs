@@ -11,6 +11,12 @@ pub enum ContactError {
     /// A body could not be prepared (validation, size).
     #[error(transparent)]
     Body(#[from] SolveError),
+    /// The run was asked to stop ([`crate::linkage::Interrupt`]) while `step` was solved.
+    #[error("step {step}: interrupted")]
+    Interrupted {
+        /// The step.
+        step: usize,
+    },
     /// A body not held by its supports found no contacts that hold it.
     #[error("step {step}: body '{body}' is not held by its supports and found no contact that holds it in {iterations} contact iterations ({contacts} contacts at the end): a load pushes it away from every surface, or the surface is far; support it, start it touching the surface, or raise [contact] max_iterations")]
     Unsupported {

@@ -121,6 +121,9 @@ impl Problem<'_> {
         last_step: Real,
         size: Real,
     ) -> Result<bool, ContactError> {
+        if interrupted(self.bodies) {
+            return Err(ContactError::Interrupted { step: self.step });
+        }
         monitor
             .record(Convergence::relative(rnorm, scale))
             .map_err(|_| ContactError::NotFinite { step: self.step })?;
@@ -451,6 +454,9 @@ impl ContactSolver {
         let mut out = ContactStep::default();
         let mut refinements = 0;
         loop {
+            if interrupted(bodies) {
+                return Err(ContactError::Interrupted { step });
+            }
             out.contact_iterations += 1;
             let (iterations, settled) =
                 self.newton(bodies, &set, (&forces, &offsets), step, inertia)?;
@@ -634,6 +640,12 @@ impl ContactSolver {
             &mut self.times,
         )
     }
+}
+
+/// Whether the run was asked to stop (the bodies' [`crate::linkage::NewtonSettings`] carry the
+/// run's interrupt).
+pub(crate) fn interrupted(bodies: &[Body]) -> bool {
+    bodies.iter().any(|b| b.newton.interrupt.is_raised())
 }
 
 /// The Newton tolerance of a contact scene (the smallest of the bodies', at most 1e-10) and the

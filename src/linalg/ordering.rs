@@ -736,6 +736,42 @@ mod tests {
         }
     }
 
+    /// The process's SIGTERM handler, as `sigaction` reports it.
+    fn sigterm_handler() -> libc::sighandler_t {
+        // SAFETY: a null new action only reads the current one into `old`.
+        let mut old: libc::sigaction = unsafe { std::mem::zeroed() };
+        let r = unsafe { libc::sigaction(libc::SIGTERM, std::ptr::null(), &mut old) };
+        assert_eq!(r, 0);
+        old.sa_sigaction
+    }
+
+    #[test]
+    fn metis_leaves_the_sigterm_handler_alone_on_two_threads() {
+        // Upstream GKlib installs a longjmp handler for SIGTERM during every METIS call (and,
+        // with two calls at once, can leave it installed): a SIGTERM then jumps through an
+        // empty buffer (a segmentation fault). The handler must be the same throughout.
+        let before = sigterm_handler();
+        let (xadj, adj) = lattice_graph(12, 12, 12);
+        let done = std::sync::atomic::AtomicBool::new(false);
+        let mut seen = 0usize;
+        std::thread::scope(|s| {
+            for _ in 0..2 {
+                s.spawn(|| {
+                    for _ in 0..6 {
+                        nested_dissection(&xadj, &adj).unwrap();
+                    }
+                    done.store(true, std::sync::atomic::Ordering::SeqCst);
+                });
+            }
+            while !done.load(std::sync::atomic::Ordering::SeqCst) {
+                assert_eq!(sigterm_handler(), before, "changed while METIS ran");
+                seen += 1;
+            }
+        });
+        assert_eq!(sigterm_handler(), before, "changed after METIS ran");
+        assert!(seen > 10, "sampled {seen} times");
+    }
+
     /// Node graph of an nx × ny × nz lattice whose nodes join their 26 neighbours.
     fn lattice_graph(nx: usize, ny: usize, nz: usize) -> (Vec<usize>, Vec<usize>) {
         let id = |x: usize, y: usize, z: usize| (z * ny + y) * nx + x;

@@ -47,6 +47,14 @@ pub enum SolveError {
         /// What faer reported.
         message: String,
     },
+    /// The run was asked to stop ([`crate::linkage::Interrupt`]) while `step` was solved.
+    #[error("body '{body}': step {step} was interrupted")]
+    Interrupted {
+        /// Body name.
+        body: String,
+        /// The step being solved.
+        step: usize,
+    },
     /// A nonlinear step did not converge even with its increment halved `depth` (= the
     /// body's `max_cuts`) times.
     #[error("body '{body}': step {step} did not converge, even with its load increment cut to 1/{} of the step ({depth} halvings deep, the most [bodies.newton] max_cuts allows; {cuts} halvings in this step in all, as the increment grows again after two successes): {reason}; relative residuals of the last attempt: [{}]. Use more steps (smaller increments), raise [bodies.newton] max_cuts or max_iterations, or follow a limit point with [bodies.path] method = \"arc_length\"", 1u64 << (*.depth).min(63), format_history(.history))]

@@ -1,5 +1,6 @@
 //! How a body relates member forces to node motion, and how its nonlinear equilibrium is found.
 
+use crate::linkage::Interrupt;
 use crate::Real;
 
 /// The kinematics of a body's members.
@@ -52,6 +53,9 @@ pub struct NewtonSettings {
     /// Whether the tangent includes the load stiffness of pressures that follow the
     /// deformation (default true; false only to compare convergence).
     pub load_stiffness: bool,
+    /// Asks the solves to stop between iterations (the run was interrupted): not part of
+    /// the physics, never read from a scene.
+    pub interrupt: Interrupt,
 }
 
 impl Default for NewtonSettings {
@@ -63,6 +67,7 @@ impl Default for NewtonSettings {
             max_cuts: 10,
             path: PathMethod::Schedules,
             load_stiffness: true,
+            interrupt: Interrupt::default(),
         }
     }
 }

@@ -25,6 +25,13 @@ pub enum RenderError {
         /// The stored steps, as text.
         stored: String,
     },
+    /// The drawing was asked to stop ([`crate::linkage::Interrupt`]) before `dir`'s frames were
+    /// all drawn: nothing of it is kept (`png/` and `anim.gif` stay as they were).
+    #[error("{dir}: drawing interrupted: png/ and anim.gif left as they were")]
+    Interrupted {
+        /// The folder being drawn into.
+        dir: PathBuf,
+    },
     /// A picture could not be encoded.
     #[error("cannot encode the {what}: {message}")]
     Encode {

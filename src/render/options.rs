@@ -1,5 +1,6 @@
 //! What a picture is drawn with: frame size, camera, projection, colouring, steps.
 
+use crate::linkage::Interrupt;
 use crate::render::RenderError;
 use crate::scene::{PictureSettings, MAX_FRAME_SIDE};
 use crate::Real;
@@ -128,6 +129,8 @@ pub struct RenderOptions {
     pub gif: bool,
     /// Samples per pixel side for the shaded surfaces (1–4; 2 gives smooth edges).
     pub supersampling: u32,
+    /// Stops the drawing between frames once raised (never by default).
+    pub interrupt: Interrupt,
 }
 
 impl Default for RenderOptions {
@@ -146,6 +149,7 @@ impl Default for RenderOptions {
             png: true,
             gif: true,
             supersampling: 2,
+            interrupt: Interrupt::default(),
         }
     }
 }

@@ -181,7 +181,17 @@ fn draw_frames(
     };
     // The palette's frames are drawn first and kept for their own turn.
     let mut kept: Vec<(usize, Frame)> = Vec::new();
+    let stopped = || {
+        if options.interrupt.is_raised() {
+            Err(RenderError::Interrupted {
+                dir: dir.to_path_buf(),
+            })
+        } else {
+            Ok(())
+        }
+    };
     let gif = if options.gif {
+        stopped()?;
         kept = palette_steps(steps)
             .into_par_iter()
             .map(|k| draw(k).map(|f| (k, f)))
@@ -194,6 +204,7 @@ fn draw_frames(
     let batch = (2 * rayon::current_num_threads()).max(4);
     let mut gif = gif;
     for (b, chunk) in steps.chunks(batch).enumerate() {
+        stopped()?;
         let done = chunk
             .par_iter()
             .map(|&k| {
@@ -226,6 +237,7 @@ fn draw_frames(
             }
         }
     }
+    stopped()?;
     if options.png {
         publish_keeping(png_dir, &final_png, &is_frame).map_err(|source| RenderError::Write {
             path: final_png.clone(),
@@ -255,7 +267,11 @@ impl DrawResults for PictureWriter {
         run: &RunResults,
         dir: &Path,
     ) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-        draw_run(run, dir, &RenderOptions::from_settings(&world.pictures))?;
+        let options = RenderOptions {
+            interrupt: world.interrupt(),
+            ..RenderOptions::from_settings(&world.pictures)
+        };
+        draw_run(run, dir, &options)?;
         Ok(())
     }
 

@@ -103,6 +103,27 @@ fn key_line(text: &str, start: usize, message: &str) -> usize {
         .map_or(first, |(_, line)| line)
 }
 
+/// The keys of a body's table that a validation error of the body is about, most likely
+/// first, as [`key_line`] reads them (those the body does not have are passed over; with none
+/// the error points at the body's header).
+fn body_error_keys(e: &crate::linkage::BodyError) -> &'static str {
+    use crate::linkage::BodyError as E;
+    match e {
+        E::Material { .. } | E::MaterialOutOfRange { .. } => "`material` `links`",
+        E::NonFiniteNode { .. } | E::NodeOffPlane { .. } => {
+            "`nodes` `offset` `mesh` `outline` `model`"
+        }
+        E::NodeOutOfRange { .. }
+        | E::SelfMember { .. }
+        | E::ZeroLength { .. }
+        | E::TooLarge { .. }
+        | E::DuplicateMember { .. } => "`links` `nodes` `mesh` `outline` `model`",
+        E::BadPatch { .. } => "`patches`",
+        E::LooseNode { .. } => "`links` `nodes` `mesh` `model`",
+        _ => "",
+    }
+}
+
 /// Byte offset of the `[output]` header in `text` (0 without one).
 fn output_start(text: &str) -> usize {
     let mut offset = 0;
@@ -242,7 +263,19 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
                 ),
             ));
         }
-        body.validate().map_err(|e| at(b.span(), e.to_string()))?;
+        body.validate().map_err(|e| {
+            let message = e.to_string();
+            SceneError::At {
+                path: path.to_path_buf(),
+                // The key the problem is in, not the body's header line.
+                line: key_line(
+                    text,
+                    b.span().start,
+                    &format!("{} {message}", body_error_keys(&e)),
+                ),
+                message,
+            }
+        })?;
         let mut body = body;
         add_self_weight(&mut body, &spec, &density).map_err(|e| at(0..0, e))?;
         bodies.push(body);
@@ -301,7 +334,7 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
         pictures,
         plots,
         source: path.to_path_buf(),
-        scene_digest: crate::scene::scene_digest(text),
+        scene_digest: crate::scene::scene_and_files_digest(text, folder),
         prepared,
         build_seconds: started.elapsed().as_secs_f64(),
     })

@@ -12,7 +12,6 @@ use crate::scene::step_writer::StepWriter;
 use crate::scene::writers::{keeps_steps, write_after_steps, write_json, write_model, DrawResults};
 use crate::scene::World;
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Run `world` and write `out/<name>/` (summary.json and steps/NNNN.json). The folder is
@@ -28,28 +27,21 @@ pub fn run(world: &World, out: &Path, on_step: &(dyn Fn() + Sync)) -> Result<Sum
 
 /// [`run`], and the pictures `world.pictures` asks for, drawn by `draw` from the complete
 /// results in memory before the folder is published (time in `phases.drawing`).
+///
+/// Once the world's interrupt is raised ([`World::set_interrupt`]: the CLI raises it on SIGINT
+/// and SIGTERM) the run stops where it is (between Newton or contact iterations, fracture
+/// events, steps, frames and writers), removes its staging folder, leaves earlier results as
+/// they were and returns [`RunError::Interrupted`].
 pub fn run_with(
     world: &World,
     out: &Path,
     on_step: &(dyn Fn() + Sync),
     draw: Option<&dyn DrawResults>,
 ) -> Result<Summary, RunError> {
-    run_until(world, out, on_step, draw, &AtomicBool::new(false))
+    run_into(world, out, &world.name, on_step, draw)
 }
 
-/// [`run_with`], stopping before the next step once `stop` is set (the CLI sets it on SIGINT
-/// and SIGTERM): the staging folder is removed and [`RunError::Interrupted`] returned.
-pub fn run_until(
-    world: &World,
-    out: &Path,
-    on_step: &(dyn Fn() + Sync),
-    draw: Option<&dyn DrawResults>,
-    stop: &AtomicBool,
-) -> Result<Summary, RunError> {
-    run_into(world, out, &world.name, on_step, draw, stop)
-}
-
-/// [`run_until`], writing `out/<folder>/` instead of `out/<name>/` (a sweep's variant `k` of
+/// [`run_with`], writing `out/<folder>/` instead of `out/<name>/` (a sweep's variant `k` of
 /// scene `s` is `DIR/s/k/`, its summary still naming the scene `s`).
 pub fn run_into(
     world: &World,
@@ -57,12 +49,11 @@ pub fn run_into(
     folder: &str,
     on_step: &(dyn Fn() + Sync),
     draw: Option<&dyn DrawResults>,
-    stop: &AtomicBool,
 ) -> Result<Summary, RunError> {
     let final_dir = out.join(folder);
     remove_stale(out, folder);
     let staging = staging_dir(out, folder);
-    let result = run_in(world, &staging, &final_dir, on_step, draw, stop);
+    let result = run_in(world, &staging, &final_dir, on_step, draw);
     if staging.exists() {
         let _ = std::fs::remove_dir_all(&staging);
     }
@@ -76,8 +67,14 @@ fn run_in(
     final_dir: &Path,
     on_step: &(dyn Fn() + Sync),
     draw: Option<&dyn DrawResults>,
-    stop: &AtomicBool,
 ) -> Result<Summary, RunError> {
+    let stop = world.interrupt();
+    // Whatever a step or a writer returns once the stop is asked for (an interrupted Newton, a
+    // drawing cut short), the run was interrupted.
+    let interrupted = |step: usize| RunError::Interrupted {
+        scene: world.source.clone(),
+        step,
+    };
     let write_err = |path: &Path| {
         let path = path.to_path_buf();
         move |source| RunError::Write { path, source }
@@ -91,7 +88,16 @@ fn run_in(
     // written, which on a million-member body takes half a second off the run's wall time.
     std::thread::scope(|scope| {
         let started = Instant::now();
-        let mut simulation = Simulation::new(world)?;
+        let mut simulation =
+            Simulation::new(world).map_err(
+                |e| {
+                    if stop.is_raised() {
+                        interrupted(0)
+                    } else {
+                        e
+                    }
+                },
+            )?;
         let setup = started.elapsed().as_secs_f64();
         // Not before the set-up: that is where the run's memory peaks.
         let model_file = scope.spawn(|| write_model(world, staging));
@@ -101,25 +107,34 @@ fn run_in(
         // Every file name of the run has enough digits for its last step, so they sort.
         let digits = step_digits(world.steps);
         let writer = StepWriter::start(scope, world, &steps_dir, digits, keep);
-        let stepped = solve_steps(
-            &mut simulation,
-            &mut summary,
-            setup,
-            on_step,
-            stop,
-            &mut |result| writer.write(result),
-        );
+        let stepped = solve_steps(&mut simulation, &mut summary, setup, on_step, &mut |result| {
+            writer.write(result)
+        });
         let finished = writer.finish();
         let stopped = stepped?;
         let (kept, writing) = finished?;
+        let last = summary.steps.len().saturating_sub(1);
+        if stop.is_raised() {
+            return Err(interrupted(last));
+        }
         summary.phases.writing += writing;
         add_solver_times(&mut summary, &simulation);
         let (model, model_seconds) = model_file
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
         summary.phases.writing += model_seconds;
-        write_after_steps(world, model, kept, staging, draw, &mut summary)?;
+        write_after_steps(world, model, kept, staging, draw, &mut summary).map_err(|e| {
+            if stop.is_raised() {
+                interrupted(last)
+            } else {
+                e
+            }
+        })?;
         write_json(&staging.join("summary.json"), &summary, true)?;
+        // Asked to stop while drawing or writing: nothing is published.
+        if stop.is_raised() {
+            return Err(interrupted(last));
+        }
         let target = destination(final_dir, stopped.is_none());
         publish(staging, &target).map_err(write_err(&target))?;
         match stopped {
@@ -133,16 +148,25 @@ fn run_in(
 }
 
 /// Solve `world` in memory: the summary and the steps its `[output]` stores (step 0, every
-/// k-th, the last), as [`run_until`] would write them, with nothing written. A step after step
+/// k-th, the last), as [`run_with`] would write them, with nothing written. A step after step
 /// 0 that cannot be solved ends the run as it does there: the summary's `failure` says why and
 /// the error comes back beside the steps solved before it.
 pub fn run_in_memory(
     world: &World,
     on_step: &(dyn Fn() + Sync),
-    stop: &AtomicBool,
 ) -> Result<(Summary, Vec<StepResult>, Option<RunError>), RunError> {
     let started = Instant::now();
-    let mut simulation = Simulation::new(world)?;
+    let stop = world.interrupt();
+    let mut simulation = Simulation::new(world).map_err(|e| {
+        if stop.is_raised() {
+            RunError::Interrupted {
+                scene: world.source.clone(),
+                step: 0,
+            }
+        } else {
+            e
+        }
+    })?;
     let setup = started.elapsed().as_secs_f64();
     let mut summary = start_summary(world, &simulation);
     let mut steps = Vec::new();
@@ -151,7 +175,6 @@ pub fn run_in_memory(
         &mut summary,
         setup,
         on_step,
-        stop,
         &mut |result| {
             steps.push(result);
             true
@@ -192,7 +215,7 @@ fn add_solver_times(summary: &mut Summary, simulation: &Simulation) {
 /// Solve steps 0..=steps of the simulation's world in order, each one's line into `summary`
 /// (`setup` s counted in step 1's time), handing the steps the world's `[output]` writes to
 /// `store` (which answers false to stop: its writer failed) and calling `on_step` after each.
-/// Stops before a step once `stop` is set ([`RunError::Interrupted`]). A collapse ends the run
+/// Stops once the world's interrupt is raised ([`RunError::Interrupted`]). A collapse ends the run
 /// as a result; a step after step 0 that cannot be solved ends it with the summary's `failure`
 /// set and the error returned as `Ok(Some(..))`; step 0's error is returned as `Err`.
 fn solve_steps(
@@ -200,20 +223,22 @@ fn solve_steps(
     summary: &mut Summary,
     setup: f64,
     on_step: &(dyn Fn() + Sync),
-    stop: &AtomicBool,
     store: &mut dyn FnMut(StepResult) -> bool,
 ) -> Result<Option<RunError>, RunError> {
     let world = simulation.world;
+    let stop = world.interrupt();
+    let interrupted = |step: usize| RunError::Interrupted {
+        scene: world.source.clone(),
+        step,
+    };
     for step in 0..=world.steps {
-        if stop.load(Ordering::Relaxed) {
-            return Err(RunError::Interrupted {
-                scene: world.source.clone(),
-                step,
-            });
+        if stop.is_raised() {
+            return Err(interrupted(step));
         }
         let t = Instant::now();
         let (result, mut line) = match simulation.step(step) {
             Ok(solved) => solved,
+            Err(_) if stop.is_raised() => return Err(interrupted(step)),
             // A collapse is a result: the summary records it and the run ends there, published
             // as a complete run.
             Err(RunError::Collapse { collapse, breaks }) if step > 0 => {

@@ -6,8 +6,8 @@ pub use self::check::{
     BYTES_PER_VALUE, NPZ_BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
 };
 pub use self::contact_concentration::{CONCENTRATED_SHARE, NEIGHBOUR_SLOPE};
-pub use self::driver::{run, run_in_memory, run_into, run_until, run_with};
 pub use self::inline_files::InlineFiles;
+pub use self::driver::{run, run_in_memory, run_into, run_with};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::plot_settings::{PlotNode, PlotSettings};
@@ -19,8 +19,8 @@ pub use self::results::{
 };
 pub use self::run_error::RunError;
 pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS};
-pub use self::scene_digest::scene_digest;
 pub use self::selector::{far_nearest_warning, select_nodes, select_nodes_in, FAR_NEAREST};
+pub use self::scene_digest::{scene_and_files_digest, scene_digest};
 pub use self::simulation::{Simulation, WorldSolver};
 pub use self::stored_run::{StoredRun, StoredRunError};
 pub use self::strain_warning::LINEAR_STRAIN_WARNING;
@@ -35,6 +35,7 @@ pub mod batch;
 mod bounds;
 mod build;
 mod capacity;
+pub mod fits_machine;
 mod check;
 mod contact_concentration;
 mod contact_pairs;

@@ -50,11 +50,11 @@ pub enum RunError {
         breaks: Vec<crate::scene::results::SummaryBreak>,
     },
     /// The run was asked to stop (SIGINT, SIGTERM) before it finished; nothing was written.
-    #[error("{scene}: interrupted before step {step}: no results written (earlier results of the scene are untouched)")]
+    #[error("{scene}: interrupted at step {step}: no results written (earlier results of the scene are untouched)")]
     Interrupted {
         /// Scene file.
         scene: PathBuf,
-        /// The step that was not started.
+        /// The step being solved, drawn or written when it stopped.
         step: usize,
     },
     /// Pictures or VTK files could not be made.

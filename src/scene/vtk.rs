@@ -23,6 +23,7 @@
 use crate::contact::cut_by_z0;
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::model_file::{ModelBody, ModelFile};
+use crate::scene::publish::{publish_keeping, remove_stale, staging_dir};
 use crate::scene::results::{BodyResult, StepResult};
 use crate::scene::run_results::RunResults;
 use crate::scene::vtu_arrays::{VtkEncoding, VtuArrays};
@@ -59,15 +60,51 @@ pub enum VtkError {
 /// results folder (`DIR/<scene>`). The collection's `timestep` is the load factor when it
 /// grows strictly over the stored steps, else the step number (ParaView needs increasing
 /// times). Returns the files written.
+///
+/// The files are written into a staging folder that then replaces `vtk/` as a whole, so `vtk/`
+/// never holds files of an older run beside these (a user's other files in it, not `.vtu` or
+/// `.pvd`, are kept), and a write that fails leaves the old `vtk/` as it was.
 pub fn write_vtk(
     run: &RunResults,
     dir: &Path,
     encoding: VtkEncoding,
 ) -> Result<Vec<PathBuf>, VtkError> {
-    let results_dir = dir;
-    let dir = results_dir.join("vtk");
-    std::fs::create_dir_all(&dir).map_err(|source| VtkError::Write {
-        path: dir.clone(),
+    let final_dir = dir.join("vtk");
+    remove_stale(dir, "vtk");
+    let staging = staging_dir(dir, "vtk");
+    let written = write_vtk_into(run, dir, &staging, encoding).and_then(|written| {
+        publish_keeping(&staging, &final_dir, &is_vtk_file).map_err(|source| VtkError::Write {
+            path: final_dir.clone(),
+            source,
+        })?;
+        Ok(written)
+    });
+    if staging.exists() {
+        let _ = std::fs::remove_dir_all(&staging);
+    }
+    Ok(written?
+        .iter()
+        .filter_map(|p| p.file_name())
+        .map(|name| final_dir.join(name))
+        .collect())
+}
+
+/// Whether `name` is a file [`write_vtk`] writes (`.vtu`, `.pvd`).
+fn is_vtk_file(name: &std::ffi::OsStr) -> bool {
+    let name = name.to_string_lossy();
+    name.ends_with(".vtu") || name.ends_with(".pvd")
+}
+
+/// The files of [`write_vtk`] written into the folder `dir` (the results folder
+/// `results_dir` names `model.json` in errors).
+fn write_vtk_into(
+    run: &RunResults,
+    results_dir: &Path,
+    dir: &Path,
+    encoding: VtkEncoding,
+) -> Result<Vec<PathBuf>, VtkError> {
+    std::fs::create_dir_all(dir).map_err(|source| VtkError::Write {
+        path: dir.to_path_buf(),
         source,
     })?;
     let mut written = Vec::new();

@@ -1,7 +1,7 @@
 //! What one run needs, built and checked from a scene file: bodies, obstacles, contact and output settings.
 
 use crate::contact::{ContactSettings, Obstacle};
-use crate::linkage::{Body, Schedule};
+use crate::linkage::{Body, Interrupt, Schedule};
 use crate::scene::{PictureSettings, PlotSettings, ResultFormat};
 use crate::Real;
 use std::path::PathBuf;
@@ -75,6 +75,25 @@ pub struct World {
 }
 
 impl World {
+    /// Make every solve of this world stop between iterations once `interrupt` is raised: it
+    /// goes into each body's [`crate::linkage::NewtonSettings`], where the body solvers, the
+    /// contact loops and fracture's events read it (and the driver and the drawing, through
+    /// [`World::interrupt`]).
+    pub fn set_interrupt(&mut self, interrupt: Interrupt) {
+        for body in &mut self.bodies {
+            body.newton.interrupt = interrupt;
+        }
+    }
+
+    /// The interrupt the world's solves read (see [`World::set_interrupt`]; never raised by
+    /// default).
+    pub fn interrupt(&self) -> Interrupt {
+        self.bodies
+            .first()
+            .map(|b| b.newton.interrupt)
+            .unwrap_or_default()
+    }
+
     /// Whether the scene is solved with contact: it has obstacles or a `[contact]` table. All
     /// its bodies are then solved together, step by step ([`crate::contact::ContactSolver`]).
     pub fn has_contact(&self) -> bool {

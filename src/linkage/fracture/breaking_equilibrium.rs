@@ -671,6 +671,12 @@ impl BreakingEquilibrium {
     ) -> Result<StepState, SolveError> {
         let mut fracture = FractureState::default();
         loop {
+            if body.newton.interrupt.is_raised() {
+                return Err(SolveError::Interrupted {
+                    body: body.name.clone(),
+                    step,
+                });
+            }
             match self.next_event(body, step, steps, &mut fracture.fallen) {
                 Ok(events) if events.is_empty() => break,
                 Ok(events) => fracture.breaks.extend(events),

@@ -3,7 +3,7 @@
 //! The load factor is an unknown, and each increment keeps the length of the free
 //! displacement increment.
 
-use super::{IncrementFailure, IncrementSize, NewtonEquilibrium};
+use super::{IncrementFailure, IncrementSize, NewtonEquilibrium, INTERRUPTED};
 use crate::linkage::body_state::{full_loads, norm};
 use crate::linkage::step_state::force_scale;
 use crate::linkage::{Body, Convergence, SolveError};
@@ -118,6 +118,9 @@ impl NewtonEquilibrium {
                     format!("no convergence in {} iterations", settings.max_iterations),
                     &convergence.history,
                 ));
+            }
+            if settings.interrupt.is_raised() {
+                return Err(fail(INTERRUPTED.to_string(), &convergence.history));
             }
             self.refactor(body)
                 .map_err(|reason| fail(reason, &convergence.history))?;

@@ -4,7 +4,9 @@
 //! from the path extrapolated through the last converged states when that is closer to
 //! equilibrium.
 
-use super::{lagrange_weights, IncrementFailure, IncrementSize, NewtonEquilibrium, PATH_POINTS};
+use super::{
+    lagrange_weights, IncrementFailure, IncrementSize, NewtonEquilibrium, INTERRUPTED, PATH_POINTS,
+};
 use crate::linkage::body_state::{norm, prescribed_at, tangent_times};
 use crate::linkage::step_state::force_scale;
 use crate::linkage::{Body, Convergence, SolveError};
@@ -125,6 +127,9 @@ impl NewtonEquilibrium {
                     ),
                     &convergence.history,
                 ));
+            }
+            if settings.interrupt.is_raised() {
+                return Err(fail(INTERRUPTED.to_string(), &convergence.history));
             }
             self.refactor(body)
                 .map_err(|reason| fail(reason, &convergence.history))?;

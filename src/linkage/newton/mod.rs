@@ -27,6 +27,10 @@ use std::time::Instant;
 mod arc_length;
 mod load_control;
 
+/// The reason of an increment stopped by [`crate::linkage::Interrupt`] (never retried: the
+/// retry returns [`SolveError::Interrupted`]).
+pub(super) const INTERRUPTED: &str = "interrupted";
+
 /// Why one load increment failed (the step is retried with half the increment).
 #[derive(Clone, Debug)]
 struct IncrementFailure {
@@ -625,6 +629,12 @@ impl IncrementSize {
         step: usize,
         failure: IncrementFailure,
     ) -> Result<(), SolveError> {
+        if body.newton.interrupt.is_raised() {
+            return Err(SolveError::Interrupted {
+                body: body.name.clone(),
+                step,
+            });
+        }
         if self.failed(body.newton.max_cuts) {
             Ok(())
         } else {

@@ -1,18 +1,23 @@
 //! One job of a batch: skipped when its complete results are there, else built and run; either
 //! way its row of the table, read from the published folder.
 
+use crate::linkage::Interrupt;
 use crate::scene::batch::jobs::Job;
 use crate::scene::batch::row::{complete_summary, job_row};
 use crate::scene::batch::table::Row;
-use crate::scene::{build_world, run_into, DrawResults, RunError, Summary, World};
+use crate::scene::{
+    build_world, run_into, write_vtk, DrawResults, RunError, RunResults, Summary, World,
+};
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
 /// What running a job did.
 #[derive(Debug)]
 pub enum Ran {
     /// Its complete results were there already (not asked to `rerun`).
     Skipped,
+    /// Its complete results were there already, and the pictures or VTK files asked for
+    /// (`--png`, `--vtk`) were drawn from them without solving.
+    Drawn,
     /// It ran and every step was solved.
     Solved {
         /// The world it ran.
@@ -41,7 +46,8 @@ pub struct JobSettings {
 
 /// Run `job` into `out` (unless its complete results are there and `settings.rerun` is off) and
 /// make its row. `on_start` sees the world before it runs (for progress and warnings);
-/// `on_step`, `draw` and `stop` are [`run_into`]'s.
+/// `on_step` and `draw` are [`run_into`]'s; `stop` becomes the world's interrupt
+/// ([`World::set_interrupt`]): once raised the job stops where it is and fails as interrupted.
 pub fn run_job(
     job: &Job,
     out: &Path,
@@ -49,7 +55,7 @@ pub fn run_job(
     draw: Option<&dyn DrawResults>,
     on_start: &(dyn Fn(&World) + Sync),
     on_step: &(dyn Fn() + Sync),
-    stop: &AtomicBool,
+    stop: Interrupt,
 ) -> (Ran, Row) {
     let folder = job.folder(out);
     let text = match &job.text {
@@ -61,12 +67,36 @@ pub fn run_job(
             )
         }
     };
+    // Asked to stop before this job began (the jobs of a batch start one after another).
+    if stop.is_raised() {
+        let why = RunError::Interrupted {
+            scene: job.scene.clone(),
+            step: 0,
+        }
+        .to_string();
+        return (
+            Ran::Failed(why.clone()),
+            job_row(job, format!("failed: {why}"), None, None),
+        );
+    }
     let started = std::time::Instant::now();
     let built = build_world(text, &job.scene).map_err(|e| {
         let message = e.to_string();
         job.describe_error(&message)
     });
     let mut world = match built {
+        // Asked to stop while the world was built (meshes prepared): it does not run.
+        Ok(_) if stop.is_raised() => {
+            let why = RunError::Interrupted {
+                scene: job.scene.clone(),
+                step: 0,
+            }
+            .to_string();
+            return (
+                Ran::Failed(why.clone()),
+                job_row(job, format!("failed: {why}"), None, None),
+            );
+        }
         Ok(world) => world,
         Err(why) => {
             return (
@@ -75,10 +105,6 @@ pub fn run_job(
             )
         }
     };
-    if !settings.rerun && complete_summary(&folder, &world).is_some() {
-        let row = job_row(job, "ok".into(), Some(&folder), Some(&world));
-        return (Ran::Skipped, row);
-    }
     if settings.png {
         world.pictures.ask_png();
     }
@@ -86,7 +112,21 @@ pub fn run_job(
         world.pictures.gif = false;
     }
     world.pictures.vtk |= settings.vtk;
-    on_start(&world);
+    world.set_interrupt(stop);
+    if let Some(summary) = (!settings.rerun)
+        .then(|| complete_summary(&folder, &world))
+        .flatten()
+    {
+        let row = |status| job_row(job, status, Some(&folder), Some(&world));
+        if !settings.png && !settings.vtk {
+            return (Ran::Skipped, row("ok".into()));
+        }
+        // Asked for pictures: drawn from the stored results, not solved again.
+        return match draw_stored(&world, &summary, &folder, draw) {
+            Ok(()) => (Ran::Drawn, row("ok".into())),
+            Err(why) => (Ran::Failed(why.clone()), row(format!("failed: {why}"))),
+        };
+    }
     let parent = job.parent(out);
     if let Err(e) = std::fs::create_dir_all(&parent) {
         let why = format!("cannot create {}: {e}", parent.display());
@@ -95,7 +135,17 @@ pub fn run_job(
             job_row(job, format!("failed: {why}"), None, None),
         );
     }
-    match run_into(&world, &parent, &job.folder_name(), on_step, draw, stop) {
+    // Refused before anything of the run is allocated.
+    let keeps = crate::scene::writers::keeps_steps(&world, draw);
+    if let Some(why) = crate::scene::fits_machine::refusal(&world, &parent, keeps) {
+        let why = format!("{}: {why}", job.scene.display());
+        return (
+            Ran::Failed(why.clone()),
+            job_row(job, format!("failed: {why}"), None, None),
+        );
+    }
+    on_start(&world);
+    match run_into(&world, &parent, &job.folder_name(), on_step, draw) {
         Ok(summary) => {
             let row = job_row(job, "ok".into(), Some(&folder), Some(&world));
             let seconds = started.elapsed().as_secs_f64();
@@ -123,4 +173,26 @@ pub fn run_job(
             (Ran::Failed(why), row)
         }
     }
+}
+
+/// Draw what `world.pictures` asks for (VTK files; PNG frames, the GIF and plots by `draw`)
+/// from the complete results in `folder` (their `summary`), each folder and file replaced
+/// atomically. The error names the folder.
+fn draw_stored(
+    world: &World,
+    summary: &Summary,
+    folder: &Path,
+    draw: Option<&dyn DrawResults>,
+) -> Result<(), String> {
+    let run = RunResults::read(folder).map_err(|e| e.to_string())?;
+    if world.pictures.vtk {
+        write_vtk(&run, folder, world.pictures.vtk_encoding).map_err(|e| e.to_string())?;
+    }
+    if let Some(draw) = draw.filter(|_| world.pictures.png || world.pictures.gif) {
+        // An interrupted drawing says so itself (and keeps the pictures as they were).
+        let failed = |e: Box<dyn std::error::Error + Send + Sync>| e.to_string();
+        draw.draw(world, &run, folder).map_err(failed)?;
+        draw.plot(world, &run, summary, folder).map_err(failed)?;
+    }
+    Ok(())
 }

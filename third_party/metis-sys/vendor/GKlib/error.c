@@ -26,10 +26,6 @@ __thread jmp_buf gk_jbuf;
 typedef void (*gksighandler_t)(int);
 
 /* These are the holders of the old singal handlers for the trapped signals */
-static __thread gksighandler_t old_SIGMEM_handler;  /* Custom signal */
-static __thread gksighandler_t old_SIGERR_handler;  /* Custom signal */
-static __thread gksighandler_t old_SIGMEM_handlers[MAX_JBUFS];  /* Custom signal */
-static __thread gksighandler_t old_SIGERR_handlers[MAX_JBUFS];  /* Custom signal */
 
 /* The following is used to control if the gk_errexit() will actually abort or not.
    There is always a single copy of this variable */
@@ -85,8 +81,10 @@ void gk_errexit(int signum, char *f_str,...)
   fprintf(stderr,"\n");
   fflush(stderr);
 
+  /* linkage: a METIS call unwinds to its own gk_sigcatch() on this thread (it returns an
+     error status) instead of raising a process-wide signal. */
   if (gk_exit_on_error)
-    raise(signum);
+    gk_sigthrow(signum);
 }
 
 
@@ -97,29 +95,29 @@ void gk_errexit(int signum, char *f_str,...)
 /***************************************************************************/
 int gk_sigtrap() 
 {
+  /* linkage: only the return point is pushed. Upstream also installs gk_sigthrow as the
+     process's SIGABRT and SIGTERM handler here, which (a) replaces the program's own SIGTERM
+     handler while METIS runs, (b) makes a SIGTERM delivered to another thread longjmp into
+     that thread's empty gk_jbufs[-1] (a segmentation fault), and (c) with two calls on two
+     threads, restores the handlers in the wrong order and leaves gk_sigthrow installed for
+     good. Errors inside METIS reach gk_sigthrow directly (gk_errexit). */
   if (gk_cur_jbufs+1 >= MAX_JBUFS)
     return 0;
 
   gk_cur_jbufs++;
-
-  old_SIGMEM_handlers[gk_cur_jbufs]  = signal(SIGMEM,  gk_sigthrow);
-  old_SIGERR_handlers[gk_cur_jbufs]  = signal(SIGERR,  gk_sigthrow);
 
   return 1;
 }
   
 
 /***************************************************************************/
-/*! This function sets the handlers for the signals to their default handlers
+/*! This function pops the return point pushed by gk_sigtrap()
  */
 /***************************************************************************/
 int gk_siguntrap() 
 {
   if (gk_cur_jbufs == -1)
     return 0;
-
-  signal(SIGMEM,  old_SIGMEM_handlers[gk_cur_jbufs]);
-  signal(SIGERR,  old_SIGERR_handlers[gk_cur_jbufs]);
 
   gk_cur_jbufs--;
 
@@ -128,13 +126,17 @@ int gk_siguntrap()
   
 
 /*************************************************************************/
-/*! This function is the custome signal handler, which all it does is to
-    perform a longjump to the most recent saved environment 
+/*! This function performs a longjump to the most recent saved environment of
+    this thread; outside any (no METIS call under way on it), it raises the
+    signal as upstream's gk_errexit does.
  */
 /*************************************************************************/
 void gk_sigthrow(int signum)
 {
-  longjmp(gk_jbufs[gk_cur_jbufs], signum);
+  if (gk_cur_jbufs < 0)
+    raise(signum);
+  else
+    longjmp(gk_jbufs[gk_cur_jbufs], signum);
 }
   
 
@@ -144,8 +146,7 @@ void gk_sigthrow(int signum)
 ****************************************************************************/
 void gk_SetSignalHandlers() 
 {
-  old_SIGMEM_handler = signal(SIGMEM,  gk_NonLocalExit_Handler);
-  old_SIGERR_handler = signal(SIGERR,  gk_NonLocalExit_Handler);
+  /* linkage: no process-wide handlers (see gk_sigtrap); unused by METIS. */
 }
   
 
@@ -154,8 +155,6 @@ void gk_SetSignalHandlers()
 ****************************************************************************/
 void gk_UnsetSignalHandlers() 
 {
-  signal(SIGMEM,  old_SIGMEM_handler);
-  signal(SIGERR,  old_SIGERR_handler);
 }
   
 

@@ -49,7 +49,7 @@ int METIS_PartMeshNodal(idx_t *ne, idx_t *nn, idx_t *eptr, idx_t *eind,
   /* get the nodal graph */
   rstatus = METIS_MeshToNodal(ne, nn, eptr, eind, &pnumflag, &xadj, &adjncy);
   if (rstatus != METIS_OK)
-    raise(SIGERR);
+    gk_sigthrow(SIGERR); /* linkage: not raise(): see GKlib's gk_sigtrap */
 
   /* partition the graph */
   if (ptype == METIS_PTYPE_KWAY) 
@@ -60,7 +60,7 @@ int METIS_PartMeshNodal(idx_t *ne, idx_t *nn, idx_t *eptr, idx_t *eind,
                   nparts, tpwgts, NULL, options, objval, npart);
 
   if (rstatus != METIS_OK)
-    raise(SIGERR);
+    gk_sigthrow(SIGERR); /* linkage: not raise(): see GKlib's gk_sigtrap */
 
   /* partition the other side of the mesh */
   InduceRowPartFromColumnPart(*ne, eptr, eind, epart, npart, *nparts, tpwgts);
@@ -119,7 +119,7 @@ int METIS_PartMeshDual(idx_t *ne, idx_t *nn, idx_t *eptr, idx_t *eind,
   /* get the dual graph */
   rstatus = METIS_MeshToDual(ne, nn, eptr, eind, ncommon, &pnumflag, &xadj, &adjncy);
   if (rstatus != METIS_OK)
-    raise(SIGERR);
+    gk_sigthrow(SIGERR); /* linkage: not raise(): see GKlib's gk_sigtrap */
 
   /* partition the graph */
   if (ptype == METIS_PTYPE_KWAY) 
@@ -130,7 +130,7 @@ int METIS_PartMeshDual(idx_t *ne, idx_t *nn, idx_t *eptr, idx_t *eind,
                   nparts, tpwgts, NULL, options, objval, epart);
 
   if (rstatus != METIS_OK)
-    raise(SIGERR);
+    gk_sigthrow(SIGERR); /* linkage: not raise(): see GKlib's gk_sigtrap */
 
 
   /* construct the node-element list */

@@ -1,0 +1,337 @@
+//! SIGTERM and SIGINT at many moments of a run (issue 33, items 1 and 2): a contact run of two
+//! balls prepared from a mesh (METIS orderings under way), a fracture run and a drawing phase.
+//! Every one exits 130 within seconds, leaves no staging folder and leaves earlier complete
+//! results as they were.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn linkage() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_linkage"))
+}
+
+/// A sphere of radius 0.05 m centred at the origin as an icosahedron subdivided twice
+/// (320 faces, outward), as OBJ text.
+fn ball_obj() -> String {
+    let g = (1.0 + 5f64.sqrt()) / 2.0;
+    let unit = |p: [f64; 3]| {
+        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        [p[0] / n * 0.05, p[1] / n * 0.05, p[2] / n * 0.05]
+    };
+    let mut v: Vec<[f64; 3]> = [
+        [-1.0, g, 0.0],
+        [1.0, g, 0.0],
+        [-1.0, -g, 0.0],
+        [1.0, -g, 0.0],
+        [0.0, -1.0, g],
+        [0.0, 1.0, g],
+        [0.0, -1.0, -g],
+        [0.0, 1.0, -g],
+        [g, 0.0, -1.0],
+        [g, 0.0, 1.0],
+        [-g, 0.0, -1.0],
+        [-g, 0.0, 1.0],
+    ]
+    .map(unit)
+    .to_vec();
+    let mut t: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..2 {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::new();
+        for [a, b, c] in t {
+            let mut m = |x: usize, y: usize| {
+                *mid.entry((x.min(y), x.max(y))).or_insert_with(|| {
+                    let (p, q) = (v[x], v[y]);
+                    v.push(unit([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
+                    v.len() - 1
+                })
+            };
+            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        t = next;
+    }
+    let mut text = String::new();
+    for p in &v {
+        text += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for f in &t {
+        text += &format!("f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
+    }
+    text
+}
+
+/// Two balls prepared from `ball.obj`, the upper pressed 10 mm down onto the lower (contact
+/// between bodies), in `dir/balls.toml`: some ten seconds of work, METIS orderings first.
+fn balls_scene(dir: &Path) -> PathBuf {
+    std::fs::write(dir.join("ball.obj"), ball_obj()).unwrap();
+    let scene = dir.join("balls.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "balls"
+steps = 6
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-5
+[[bodies]]
+name = "lower"
+mesh = { file = "ball.obj", spacing = 0.02 }
+[[bodies.supports]]
+inside = { min = [-0.1, -0.1, -0.1], max = [0.1, -0.045, 0.1] }
+fix = ["x", "y", "z"]
+[[bodies]]
+name = "upper"
+mesh = { file = "ball.obj", spacing = 0.02 }
+offset = [0.0, 0.1, 0.0]
+[[bodies.supports]]
+inside = { min = [-0.1, 0.145, -0.1], max = [0.1, 0.2, 0.1] }
+fix = ["x", "y", "z"]
+displacement = [0.0, -0.01, 0.0]
+[contact]
+"#,
+    )
+    .unwrap();
+    scene
+}
+
+/// A quick complete run named `name` into `out` (the paper's square truss): the earlier complete
+/// results an interrupted run of the same name must leave as they were. Returns its summary's
+/// bytes.
+fn earlier_results(dir: &Path, out: &Path, name: &str) -> Vec<u8> {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let text = std::fs::read_to_string(scenes.join("paper_square.toml"))
+        .unwrap()
+        .replace("name = \"paper_square\"", &format!("name = \"{name}\""))
+        .replace(
+            "\"square.nodes\"",
+            &format!("{:?}", scenes.join("square.nodes").display().to_string()),
+        )
+        .replace(
+            "\"square.links\"",
+            &format!("{:?}", scenes.join("square.links").display().to_string()),
+        );
+    let scene = dir.join(format!("earlier_{name}.toml"));
+    std::fs::write(&scene, text).unwrap();
+    let o = linkage()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::read(out.join(name).join("summary.json")).unwrap()
+}
+
+/// Send `signal` to `child`.
+fn send(child: &Child, signal: i32) {
+    // SAFETY: kill(2) on our own child's pid.
+    let r = unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+    assert_eq!(r, 0, "kill failed");
+}
+
+/// What one interrupted run showed: its exit code (`None`: killed by a signal, e.g. a crash),
+/// seconds from the signal to its exit, stderr.
+struct Stopped {
+    code: Option<i32>,
+    seconds: f64,
+    stderr: String,
+}
+
+/// Start `linkage args`, send `signal` after `after`, and wait (at most 60 s) for it to end.
+fn interrupt(args: &[&std::ffi::OsStr], after: Duration, signal: i32) -> Stopped {
+    let mut child = linkage()
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(after);
+    let finished_before = child.try_wait().unwrap();
+    if finished_before.is_none() {
+        send(&child, signal);
+    }
+    let sent = Instant::now();
+    loop {
+        if child.try_wait().unwrap().is_some() || sent.elapsed() > Duration::from_secs(60) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let seconds = sent.elapsed().as_secs_f64();
+    let _ = child.kill();
+    let o = child.wait_with_output().unwrap();
+    Stopped {
+        code: if finished_before.is_some() {
+            Some(-1)
+        } else {
+            o.status.code()
+        },
+        seconds,
+        stderr: String::from_utf8_lossy(&o.stderr).into_owned(),
+    }
+}
+
+/// The entries of `out` whose names begin with a dot (staging and exchanged-out folders).
+fn hidden(out: &Path) -> Vec<String> {
+    std::fs::read_dir(out)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect()
+}
+
+/// Interrupt `scene` (run with `extra` options into `out`) at each of `moments` (s),
+/// alternating SIGTERM and SIGINT, and check each stop: exit 130 within 5 s of the signal, the
+/// message, no staging folder, `out/<name>/summary.json` still `earlier`.
+fn check_stops(
+    scene: &Path,
+    extra: &[&str],
+    out: &Path,
+    name: &str,
+    earlier: &[u8],
+    moments: &[f64],
+) {
+    let mut args: Vec<&std::ffi::OsStr> = vec!["run".as_ref(), scene.as_os_str()];
+    args.extend(extra.iter().map(|a| std::ffi::OsStr::new(*a)));
+    args.extend(["--out".as_ref(), out.as_os_str()]);
+    for (k, &t) in moments.iter().enumerate() {
+        let signal = if k % 2 == 0 {
+            libc::SIGTERM
+        } else {
+            libc::SIGINT
+        };
+        let s = interrupt(&args, Duration::from_secs_f64(t), signal);
+        let what = format!("{name}: signal {signal} at {t} s");
+        assert_ne!(s.code, Some(-1), "{what}: the run ended before the signal");
+        assert_eq!(s.code, Some(130), "{what}: {}", s.stderr);
+        assert!(s.seconds < 5.0, "{what}: took {:.2} s to stop", s.seconds);
+        assert!(
+            s.stderr.contains("interrupted: stopping now"),
+            "{what}: {}",
+            s.stderr
+        );
+        assert!(hidden(out).is_empty(), "{what}: left {:?}", hidden(out));
+        assert_eq!(
+            std::fs::read(out.join(name).join("summary.json")).unwrap(),
+            earlier,
+            "{what}: the earlier results changed"
+        );
+        assert!(!out.join(name).join("png").exists(), "{what}");
+    }
+}
+
+#[test]
+fn sigterm_and_sigint_at_ten_moments_of_a_contact_run_of_meshed_balls_exit_130() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = balls_scene(dir.path());
+    let out = dir.path().join("out");
+    let earlier = earlier_results(dir.path(), &out, "balls");
+    let moments: Vec<f64> = (1..=10).map(|k| 0.25 * k as f64).collect();
+    check_stops(&scene, &[], &out, "balls", &earlier, &moments);
+}
+
+#[test]
+fn sigterm_and_sigint_during_a_fracture_run_exit_130() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/wedge_split.toml");
+    let out = dir.path().join("out");
+    let earlier = earlier_results(dir.path(), &out, "wedge_split");
+    check_stops(
+        &scene,
+        &[],
+        &out,
+        "wedge_split",
+        &earlier,
+        &[0.5, 1.0, 2.0, 3.0],
+    );
+}
+
+#[test]
+fn sigterm_and_sigint_while_drawing_exit_130_and_keep_no_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper_shell.toml"),
+    )
+    .unwrap()
+    .replace("steps = 4", "steps = 40");
+    let scene = dir.path().join("paper_shell.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.path().join("out");
+    // The earlier complete results: the same scene, without pictures.
+    let o = linkage()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let earlier = std::fs::read(out.join("paper_shell/summary.json")).unwrap();
+    // 41 frames take several seconds; the steps a fraction of one.
+    check_stops(
+        &scene,
+        &["--png", "--rerun"],
+        &out,
+        "paper_shell",
+        &earlier,
+        &[0.6, 1.0, 1.5, 2.5],
+    );
+}
+
+#[test]
+fn a_closed_stdout_ends_the_run_quietly_and_writes_batch_csv() {
+    // `linkage run ... | head -1`: the reader is gone before the first line is printed.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let mut child = linkage()
+        .args([
+            "run",
+            "scenes/paper_square.toml",
+            "scenes/paper_overload.toml",
+            "--out",
+        ])
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("Broken pipe"),
+        "{stderr}"
+    );
+    let table = std::fs::read_to_string(out.join("batch.csv")).unwrap();
+    assert_eq!(table.lines().count(), 3, "{table}");
+    for scene in ["paper_square", "paper_overload"] {
+        assert!(out.join(scene).join("summary.json").is_file(), "{scene}");
+    }
+    assert!(hidden(&out).is_empty(), "{:?}", hidden(&out));
+}
