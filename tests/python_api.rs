@@ -3,8 +3,9 @@
 //! paper files are held in memory (`build_world_with`) are the bodies read from those files;
 //! and a scene written back from its spec types (`Scene.to_dict`) builds the same world.
 
+use linkage::linkage::Interrupt;
 use linkage::scene::{
-    build_world, build_world_with, load_scene, run_in_memory, run_until, InlineFiles, RunResults,
+    build_world, build_world_with, load_scene, run_in_memory, run_with, InlineFiles, RunResults,
 };
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -18,14 +19,13 @@ fn a_run_in_memory_holds_the_steps_a_run_writes() {
     let scene = dir.path().join("two_disks.toml");
     std::fs::write(&scene, &text).unwrap();
     let world = load_scene(&scene).unwrap();
-    let stop = AtomicBool::new(false);
-    let written = run_until(&world, dir.path(), &|| {}, None, &stop).unwrap();
+    let written = run_with(&world, dir.path(), &|| {}, None).unwrap();
     let stored = RunResults::read(&dir.path().join("two_disks")).unwrap();
     let counted = std::sync::atomic::AtomicUsize::new(0);
     let on_step = || {
         counted.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     };
-    let (summary, steps, failure) = run_in_memory(&world, &on_step, &stop).unwrap();
+    let (summary, steps, failure) = run_in_memory(&world, &on_step).unwrap();
     assert!(failure.is_none());
     assert_eq!(steps, stored.steps);
     assert_eq!(stored.step_numbers(), vec![0, 2, 4]);
@@ -47,9 +47,11 @@ fn a_run_in_memory_holds_the_steps_a_run_writes() {
 
 #[test]
 fn a_stop_flag_set_before_the_run_stops_it_before_step_0() {
-    let world = load_scene(Path::new("scenes/paper_square.toml")).unwrap();
-    let e = run_in_memory(&world, &|| {}, &AtomicBool::new(true)).unwrap_err();
-    assert!(e.to_string().contains("interrupted before step 0"), "{e}");
+    let mut world = load_scene(Path::new("scenes/paper_square.toml")).unwrap();
+    let raised: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(true)));
+    world.set_interrupt(Interrupt::on(raised));
+    let e = run_in_memory(&world, &|| {}).unwrap_err();
+    assert!(e.to_string().contains("interrupted at step 0"), "{e}");
 }
 
 #[test]

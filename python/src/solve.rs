@@ -10,7 +10,8 @@
 use crate::errors::run_error;
 use crate::results::Results;
 use linkage::render::PictureWriter;
-use linkage::scene::{run_in_memory, run_until, RunError, World};
+use linkage::linkage::Interrupt;
+use linkage::scene::{run_in_memory, run_with, RunError, World};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -57,23 +58,29 @@ pub fn run_world(
     out: Option<PathBuf>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Results> {
-    let stop = Arc::new(AtomicBool::new(false));
+    // The library's interrupt is a handle on a flag that lives as long as the process: one
+    // byte per run, leaked on purpose (a solve thread still stopping may outlive this call).
+    let stop: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
     let done = Arc::new(AtomicUsize::new(0));
     let total = world.steps + 1;
     let (send, receive) = mpsc::channel::<Solved>();
     {
-        let (stop, done) = (stop.clone(), done.clone());
+        let done = done.clone();
         let running = Running::start();
         std::thread::Builder::new()
             .name(format!("linkage {}", world.name))
             .spawn(move || {
                 let _running = running;
+                // The world the solve reads carries the interrupt (every body's Newton
+                // settings): a copy when the scene object still holds the world.
+                let mut world = Arc::unwrap_or_clone(world);
+                world.set_interrupt(Interrupt::on(stop));
                 // A thread pool of its own (as many threads as rayon's global one would have):
                 // the library's parallel loops and faer's kernels of two solves started from
                 // two Python threads then run side by side instead of queueing in one pool.
                 let solved = match rayon::ThreadPoolBuilder::new().build() {
-                    Ok(pool) => pool.install(|| solve(&world, out, &stop, &done)),
-                    Err(_) => solve(&world, out, &stop, &done),
+                    Ok(pool) => pool.install(|| solve(&world, out, &done)),
+                    Err(_) => solve(&world, out, &done),
                 };
                 let _ = send.send(solved);
             })
@@ -93,7 +100,7 @@ pub fn run_world(
         Ok(())
     };
     // The receiver moves into the watch loop (it is Send, not Sync); the rest is borrowed.
-    let (report_ref, stop_ref, reported_ref) = (&report, &stop, &mut reported);
+    let (report_ref, stop_ref, reported_ref) = (&report, stop, &mut reported);
     let outcome: Result<Solved, PyErr> = py.detach(move || loop {
         match receive.recv_timeout(WATCH) {
             Ok(solved) => return Ok(solved),
@@ -128,7 +135,7 @@ pub fn run_world(
 }
 
 /// The solve itself, on the solve thread.
-fn solve(world: &World, out: Option<PathBuf>, stop: &AtomicBool, done: &AtomicUsize) -> Solved {
+fn solve(world: &World, out: Option<PathBuf>, done: &AtomicUsize) -> Solved {
     let on_step = || {
         done.fetch_add(1, Ordering::Relaxed);
     };
@@ -144,7 +151,7 @@ fn solve(world: &World, out: Option<PathBuf>, stop: &AtomicBool, done: &AtomicUs
                     source,
                 })
             })?;
-            run_until(world, &out, &on_step, Some(&PictureWriter), stop).map_err(fail)?;
+            run_with(world, &out, &on_step, Some(&PictureWriter)).map_err(fail)?;
             let folder = out.join(&world.name);
             Results::read(folder.clone()).map_err(|e| {
                 fail(RunError::Draw {
@@ -153,7 +160,7 @@ fn solve(world: &World, out: Option<PathBuf>, stop: &AtomicBool, done: &AtomicUs
                 })
             })
         }
-        None => match run_in_memory(world, &on_step, stop) {
+        None => match run_in_memory(world, &on_step) {
             Ok((summary, steps, None)) => Ok(Results::new(steps, Some(summary), None)),
             Ok((summary, steps, Some(error))) => Err(RunFailure {
                 error,
