@@ -1,5 +1,5 @@
 //! Pictures of stored results: PNG frames and a GIF of a run, 2D line art and shaded 3D
-//! patches and the glTF animation.
+//! patches, the glTF animation and the report's 3D viewer.
 
 pub use self::animated_run::{
     evenly_spaced, stored_time, AnimatedBody, AnimatedObstacle, AnimatedRun, AnimationFrame,
@@ -44,3 +44,4 @@ mod raster;
 pub mod report;
 mod run_pictures;
 mod text;
+pub mod viewer;
