@@ -282,6 +282,10 @@ struct RenderArgs {
     /// With --vtk: write the arrays as ASCII text instead of compressed binary.
     #[arg(long, requires = "vtk")]
     vtk_ascii: bool,
+    /// Also write anim.glb, the glTF 2.0 animation of the stored steps (Blender: File >
+    /// Import > glTF 2.0).
+    #[arg(long)]
+    gltf: bool,
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {
@@ -787,7 +791,8 @@ fn export(scene: &Path, out: &Path) -> Result<()> {
 }
 
 fn render(a: &RenderArgs) -> Result<()> {
-    use linkage::render::{render_run_to, RenderOptions};
+    use linkage::render::gltf::write_gltf;
+    use linkage::render::{render_run_to, stored_time, RenderOptions};
     use linkage::scene::{write_vtk, RunResults, VtkEncoding};
     catch_signals();
     // A published results folder always has its summary: without it the folder is not one.
@@ -837,6 +842,24 @@ fn render(a: &RenderArgs) -> Result<()> {
                 .as_ref()
                 .map(|g| format!(", {}", g.display()))
                 .unwrap_or_default()
+        );
+    }
+    if a.gltf {
+        let run = RunResults::read(&a.dir)?;
+        let g = write_gltf(&run, &out, report.magnification, stored_time)?;
+        println!(
+            "wrote {} ({} frame{} of {} stored step{}{}, displacements ×{})",
+            g.path.display(),
+            g.frames,
+            if g.frames == 1 { "" } else { "s" },
+            g.stored_steps,
+            if g.stored_steps == 1 { "" } else { "s" },
+            if g.frames < g.stored_steps {
+                ": evenly spaced, the first and last kept"
+            } else {
+                ""
+            },
+            report.magnification
         );
     }
     if a.vtk {

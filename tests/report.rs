@@ -73,6 +73,9 @@ impl Browser {
                 "--disable-component-update",
                 "--disable-sync",
                 "--remote-debugging-pipe",
+                // WebGL without a GPU, for the report's 3D viewer.
+                "--use-angle=swiftshader",
+                "--enable-unsafe-swiftshader",
             ])
             .arg(format!("--user-data-dir={}", profile.path().display()))
             .arg("about:blank")
@@ -385,4 +388,101 @@ fn the_report_opens_in_chromium_with_every_image_and_every_job() {
         errors.is_empty(),
         "the variant's page logged errors: {errors:?}"
     );
+}
+
+/// The viewer's state: whether it has WebGL, its frames, and the picture's drawn pixels and
+/// fingerprint.
+const VIEWER_STATE: &str = "JSON.stringify((() => { const v = window.linkageViewer; \
+    if (!v) return {ready: false}; if (!v.webgl) return {ready: true, webgl: false}; \
+    return {ready: true, webgl: true, frames: v.frames, frame: v.frame(), \
+    label: document.getElementById('viewer-label').textContent, ...v.pixels()}; })())";
+
+/// Move the viewer's slider to frame `k` as a user does (an `input` event).
+fn slide(k: usize) -> String {
+    format!(
+        "(() => {{ const s = document.getElementById('viewer-slider'); s.value = '{k}'; \
+         s.dispatchEvent(new Event('input')); return JSON.stringify(1); }})()"
+    )
+}
+
+/// Click the viewer's checkbox `name` (`contacts`, `broken`, `obstacles`).
+fn click(name: &str) -> String {
+    format!("(() => {{ document.getElementById('viewer-{name}').click(); return JSON.stringify(1); }})()")
+}
+
+#[test]
+fn the_viewer_draws_a_2d_and_a_3d_run_and_its_slider_and_toggles_change_the_picture() {
+    let Some(program) = chromium() else {
+        let why = "no chromium on PATH (Debian: apt-get install chromium)";
+        assert!(!required(), "CI=true: {why}");
+        eprintln!("skipped: {why}");
+        return;
+    };
+    let out = tempfile::tempdir().unwrap();
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    // The notched beam: 2D, pressed by a cylinder (contact), breaking (fracture). The shell:
+    // 3D, pressed by a rising block.
+    let o = linkage()
+        .arg("run")
+        .arg(scenes.join("notched_beam.toml"))
+        .arg(scenes.join("shell_on_block_moving.toml"))
+        .arg("--out")
+        .arg(out.path())
+        .arg("--png")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{o:?}");
+    let mut browser = Browser::start(&program);
+    let tab = browser.tab();
+    for (scene, toggles) in [
+        ("notched_beam", ["contacts", "broken"]),
+        ("shell_on_block_moving", ["contacts", "obstacles"]),
+    ] {
+        let dir = out.path().join(scene);
+        let stored = std::fs::read_dir(dir.join("steps")).unwrap().count();
+        browser.events.clear();
+        browser.open(&tab, &dir.join("index.html"));
+        let first = browser.evaluate(&tab, VIEWER_STATE);
+        assert_eq!(first["webgl"], json!(true), "{scene}: {first}");
+        assert_eq!(first["frames"], json!(stored), "{scene}: every stored step");
+        let total = first["total"].as_u64().unwrap();
+        let drawn = first["drawn"].as_u64().unwrap();
+        assert!(
+            drawn * 200 > total,
+            "{scene}: the canvas is drawn (over 0.5 % of it): {first}"
+        );
+        browser.evaluate(&tab, &slide(stored - 1));
+        let last = browser.evaluate(&tab, VIEWER_STATE);
+        assert_eq!(last["frame"], json!(stored - 1), "{last}");
+        assert_ne!(
+            last["hash"], first["hash"],
+            "{scene}: the last step looks different"
+        );
+        assert!(
+            last["label"]
+                .as_str()
+                .unwrap()
+                .contains(&format!("{stored} of {stored}")),
+            "{last}"
+        );
+        for t in toggles {
+            browser.evaluate(&tab, &click(t));
+            let off = browser.evaluate(&tab, VIEWER_STATE);
+            assert_ne!(
+                off["hash"], last["hash"],
+                "{scene}: switching {t} off changes the picture"
+            );
+            browser.evaluate(&tab, &click(t));
+            let on = browser.evaluate(&tab, VIEWER_STATE);
+            assert_eq!(
+                on["hash"], last["hash"],
+                "{scene}: switching {t} on again restores it"
+            );
+        }
+        let errors = browser.errors(&tab);
+        assert!(
+            errors.is_empty(),
+            "{scene}'s page logged errors: {errors:?}"
+        );
+    }
 }

@@ -1,5 +1,10 @@
-//! Pictures of stored results: PNG frames and a GIF of a run, 2D line art and shaded 3D patches.
+//! Pictures of stored results: PNG frames and a GIF of a run, 2D line art and shaded 3D
+//! patches, the glTF animation and the report's 3D viewer.
 
+pub use self::animated_run::{
+    evenly_spaced, stored_time, AnimatedBody, AnimatedObstacle, AnimatedRun, AnimationFrame,
+    BodyShape, FrameBudget, FRAME_RATE,
+};
 pub use self::camera::{Camera, View, FIELD_OF_VIEW};
 pub use self::colour_scale::{
     colour_at, format_si, ColourScale, Rgb, CONTACT_ORANGE, FORCE_BLUE, OBSTACLE_FILL,
@@ -17,6 +22,7 @@ pub use self::run_pictures::{
     draw_run, render_run, render_run_to, select_steps, PictureWriter, RenderReport,
 };
 
+mod animated_run;
 mod camera;
 mod colour_scale;
 mod deformed_body;
@@ -26,6 +32,7 @@ mod error;
 mod extent;
 mod frame;
 mod gif;
+pub mod gltf;
 mod markers;
 mod obstacles;
 mod options;
@@ -37,3 +44,4 @@ mod raster;
 pub mod report;
 mod run_pictures;
 mod text;
+pub mod viewer;

@@ -1,8 +1,10 @@
 //! The pictures of a whole run: PNG frames and the GIF of its stored steps, drawn from its
 //! results in memory (during `linkage run`) or read back from a results folder (`linkage render`).
 
+use crate::render::gltf::write_gltf;
 use crate::render::{
-    draw_frame, Frame, GifAnimation, RenderError, RenderOptions, RunExtent, StepSelection,
+    draw_frame, stored_time, Frame, GifAnimation, RenderError, RenderOptions, RunExtent,
+    StepSelection,
 };
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::publish::{publish_keeping, remove_stale, staging_dir};
@@ -255,7 +257,8 @@ fn draw_frames(
     Ok(report)
 }
 
-/// Draws the pictures a scene asks for (`[output] png`, `gif`) during `linkage run`: pass it
+/// Draws the pictures a scene asks for (`[output] png`, `gif`) and its glTF animation
+/// (`[output] gltf`) during `linkage run`: pass it
 /// to [`crate::scene::run_with`].
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PictureWriter;
@@ -271,7 +274,10 @@ impl DrawResults for PictureWriter {
             interrupt: world.interrupt(),
             ..RenderOptions::from_settings(&world.pictures)
         };
-        draw_run(run, dir, &options)?;
+        let drawn = draw_run(run, dir, &options)?;
+        if world.pictures.gltf {
+            write_gltf(run, dir, drawn.magnification, stored_time)?;
+        }
         Ok(())
     }
 

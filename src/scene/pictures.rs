@@ -14,6 +14,8 @@ pub struct PictureSettings {
     pub gif: bool,
     /// Write `vtk/NNNN.vtu` per stored step and `vtk/<scene>.pvd`.
     pub vtk: bool,
+    /// Write `anim.glb`, the glTF 2.0 animation of the stored steps (`[output] gltf`).
+    pub gltf: bool,
     /// How the `.vtu` files store their arrays (`[output] vtk_format`).
     pub vtk_encoding: VtkEncoding,
     /// Frame width, pixels.
@@ -37,6 +39,7 @@ impl Default for PictureSettings {
             png: false,
             gif: false,
             vtk: false,
+            gltf: false,
             vtk_encoding: VtkEncoding::Binary,
             width: 1280,
             height: 720,
@@ -105,6 +108,7 @@ impl PictureSettings {
             png,
             gif: spec.gif.unwrap_or(png),
             vtk: spec.vtk.unwrap_or(false),
+            gltf: spec.gltf.unwrap_or(false),
             vtk_encoding,
             width: side("width", spec.width, d.width)?,
             height: side("height", spec.height, d.height)?,

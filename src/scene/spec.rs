@@ -502,6 +502,8 @@ pub struct OutputSpec {
     pub gif: Option<bool>,
     /// ParaView files.
     pub vtk: Option<bool>,
+    /// glTF 2.0 animation, `anim.glb`.
+    pub gltf: Option<bool>,
     /// How ParaView files store their arrays: `"binary"` (default) or `"ascii"`.
     pub vtk_format: Option<String>,
     /// Frame width, pixels.

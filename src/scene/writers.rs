@@ -17,7 +17,8 @@ use std::time::Instant;
 /// Draws pictures of a run's results. `scene` does not draw; `render` implements this
 /// (`linkage::render::PictureWriter`) and the caller of [`crate::scene::run_with`] passes it in.
 pub trait DrawResults: Sync {
-    /// Draw the pictures `world.pictures` asks for of `run` into the results folder `dir`,
+    /// Draw the pictures (and the glTF animation) `world.pictures` asks for of `run` into the
+    /// results folder `dir`,
     /// writing each file atomically. The error's message is a complete sentence naming the file.
     fn draw(
         &self,
@@ -42,7 +43,12 @@ pub trait DrawResults: Sync {
 /// Whether the writers after the load steps (VTK files, pictures by `draw`) need the stored
 /// steps kept in memory.
 pub(crate) fn keeps_steps(world: &World, draw: Option<&dyn DrawResults>) -> bool {
-    world.pictures.vtk || (draw.is_some() && (world.pictures.png || world.pictures.gif))
+    world.pictures.vtk || (draw.is_some() && draws(world))
+}
+
+/// Whether `world` asks [`DrawResults::draw`] for anything: pictures or the glTF animation.
+fn draws(world: &World) -> bool {
+    world.pictures.png || world.pictures.gif || world.pictures.gltf
 }
 
 /// Write `value` as JSON to `path` (atomically; `pretty`: indented); returns the bytes.
@@ -135,7 +141,7 @@ pub(crate) fn write_after_steps(
 ) -> Result<(), RunError> {
     let phases = &mut summary.phases;
     let t = Instant::now();
-    let drawing = draw.filter(|_| world.pictures.png || world.pictures.gif);
+    let drawing = draw.filter(|_| draws(world));
     if !world.pictures.vtk && drawing.is_none() {
         phases.writing += t.elapsed().as_secs_f64();
         return Ok(());

@@ -1,5 +1,7 @@
 //! The pieces every report page shares: escaping text and links, the page shell and its style.
 
+use crate::render::viewer::VIEWER_STYLE;
+
 /// `text` with the characters HTML gives a meaning to replaced by their entities, safe in
 /// element content and in quoted attributes.
 pub fn escape(text: &str) -> String {
@@ -77,7 +79,7 @@ pub fn page(title: &str, body: &str) -> String {
     format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>{}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n{body}</body>\n</html>\n",
+         <title>{}</title>\n<style>{STYLE}{VIEWER_STYLE}</style>\n</head>\n<body>\n{body}</body>\n</html>\n",
         escape(title)
     )
 }

@@ -6,8 +6,10 @@ use crate::render::report::html::{escape, link, page};
 use crate::render::report::job_files::JobFiles;
 use crate::scene::batch::Row;
 
-/// The page of the job of `row`, in its results folder (`files.folder`).
-pub fn scene_page(row: &Row, files: &JobFiles) -> String {
+/// The page of the job of `row`, in its results folder (`files.folder`), with `viewer` (the
+/// HTML of its 3D view, [`crate::render::viewer::viewer_section`], or a note why there is
+/// none) after its facts.
+pub fn scene_page(row: &Row, files: &JobFiles, viewer: &str) -> String {
     let f = Facts::of(row, files);
     let up: Vec<&str> = files.folder.iter().map(|_| "..").collect();
     let mut back = up.clone();
@@ -46,6 +48,7 @@ pub fn scene_page(row: &Row, files: &JobFiles) -> String {
         "</dl>\n<p class=\"note\">Results: <a href=\"summary.json\">summary.json</a>, \
          <code>steps/</code>.</p>\n",
     );
+    body.push_str(viewer);
     if !files.plots.is_empty() {
         body.push_str("<h2>Plots</h2>\n");
         for p in &files.plots {

@@ -1,10 +1,14 @@
 //! Writing the report of a batch: `DIR/index.html` and a page per job with results.
 
 use crate::render::report::batch_page::batch_page;
+use crate::render::report::html::escape;
 use crate::render::report::job_files::JobFiles;
 use crate::render::report::scene_page::scene_page;
+use crate::render::viewer::{viewer_data, viewer_section, VIEWER_BUDGET};
+use crate::render::{stored_time, AnimatedRun, RunExtent};
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::batch::Row;
+use crate::scene::RunResults;
 use std::path::{Path, PathBuf};
 
 /// The report's file name, in `DIR` and in each job's results folder.
@@ -17,9 +21,11 @@ pub fn write_report(out: &Path, rows: &[Row]) -> std::io::Result<PathBuf> {
     let jobs: Vec<(&Row, JobFiles)> = rows.iter().map(|r| (r, JobFiles::find(out, r))).collect();
     for (row, files) in &jobs {
         if !files.folder.is_empty() {
+            let dir = files.dir(out);
+            let viewer = viewer_of(&dir);
             write_atomically(
-                &files.dir(out).join(REPORT),
-                scene_page(row, files).as_bytes(),
+                &dir.join(REPORT),
+                scene_page(row, files, &viewer).as_bytes(),
             )?;
         }
     }
@@ -39,6 +45,23 @@ pub fn write_report(out: &Path, rows: &[Row]) -> std::io::Result<PathBuf> {
     let path = out.join(REPORT);
     write_atomically(&path, batch_page(&title, &jobs).as_bytes())?;
     Ok(path)
+}
+
+/// The 3D view of the results in `dir` (its stored steps read back, decimated to
+/// [`VIEWER_BUDGET`], displacements magnified as the pictures do by default), or a note why
+/// there is none.
+fn viewer_of(dir: &Path) -> String {
+    match RunResults::read(dir) {
+        Ok(run) => {
+            let magnification = RunExtent::of_run(&run, None).magnification;
+            let animation = AnimatedRun::of_run(&run, magnification, VIEWER_BUDGET, stored_time);
+            viewer_section(&viewer_data(&animation))
+        }
+        Err(e) => format!(
+            "<h2>3D view</h2>\n<p class=\"note\">No 3D view: {}</p>\n",
+            escape(&e.to_string())
+        ),
+    }
 }
 
 /// Whether any job of `rows` has pictures in `out` (frames, an animation or plots): then a
