@@ -340,6 +340,16 @@ impl Body {
 
     /// Check everything that can be checked before solving; the first problem found is returned.
     pub fn validate(&self) -> Result<(), BodyError> {
+        self.validate_held(true)
+    }
+
+    /// [`Body::validate`] for a body in time: inertia holds it, so it needs no supports.
+    pub fn validate_moving(&self) -> Result<(), BodyError> {
+        self.validate_held(false)
+    }
+
+    /// The checks of [`Body::validate`]; supports are required when `needs_supports`.
+    fn validate_held(&self, needs_supports: bool) -> Result<(), BodyError> {
         let body = || self.name.clone();
         for m in &self.materials {
             if let Some(problem) = m.problem() {
@@ -419,7 +429,7 @@ impl Body {
                 node: n + 1,
             });
         }
-        if self.supports.iter().all(|s| !s.fixed.iter().any(|f| *f)) {
+        if needs_supports && self.supports.iter().all(|s| !s.fixed.iter().any(|f| *f)) {
             return Err(BodyError::NoSupports { body: body() });
         }
         for (i, s) in self.supports.iter().enumerate() {

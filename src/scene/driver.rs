@@ -7,8 +7,8 @@ use crate::scene::publish::{destination, publish, remove_stale, staging_dir};
 use crate::scene::results::{PhaseSeconds, Summary, SummaryBreak};
 use crate::scene::run_error::RunError;
 use crate::scene::run_results::step_digits;
-use crate::scene::simulation::Simulation;
 use crate::scene::step_writer::StepWriter;
+use crate::scene::stepper::Stepper;
 use crate::scene::writers::{keeps_steps, write_after_steps, write_json, write_model, DrawResults};
 use crate::scene::World;
 use std::path::Path;
@@ -91,7 +91,7 @@ fn run_in(
     // written, which on a million-member body takes half a second off the run's wall time.
     std::thread::scope(|scope| {
         let started = Instant::now();
-        let mut simulation = Simulation::new(world)?;
+        let mut simulation = Stepper::new(world)?;
         let setup = started.elapsed().as_secs_f64();
         // Not before the set-up: that is where the run's memory peaks.
         let model_file = scope.spawn(|| write_model(world, staging));

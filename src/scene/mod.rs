@@ -6,6 +6,7 @@ pub use self::check::{
     BYTES_PER_VALUE, NPZ_BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
 };
 pub use self::driver::{run, run_into, run_until, run_with};
+pub use self::dynamic_simulation::{solve_time_step, DynamicSimulation, MAX_TIME_STEP_HALVINGS};
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
 pub use self::plot_settings::{PlotNode, PlotSettings};
@@ -20,6 +21,7 @@ pub use self::run_results::{step_digits, step_stem, RunResults, MIN_STEP_DIGITS}
 pub use self::scene_digest::scene_digest;
 pub use self::selector::select_nodes;
 pub use self::simulation::{Simulation, WorldSolver};
+pub use self::stepper::Stepper;
 pub use self::stored_run::{StoredRun, StoredRunError};
 pub use self::sweep::{expand_sweep, SweepMode, Variant};
 pub use self::vtk::{write_vtk, VtkError};
@@ -34,6 +36,8 @@ mod build;
 mod check;
 mod contact_pairs;
 mod driver;
+mod dynamic_simulation;
+pub mod dynamics_settings;
 mod instability;
 mod link_lines;
 mod mesh_file;
@@ -57,6 +61,7 @@ mod selector;
 mod simulation;
 pub mod spec;
 mod step_writer;
+mod stepper;
 mod stored_run;
 pub mod sweep;
 mod vtk;
