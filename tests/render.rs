@@ -40,6 +40,7 @@ fn square() -> (ModelFile, StepResult) {
     let step = StepResult {
         step: 1,
         load_factor: 1.0,
+        time: None,
         bodies: vec![BodyResult {
             name: "b".into(),
             displacements: vec![vec![0.0, 0.0]; 4],
@@ -52,6 +53,7 @@ fn square() -> (ModelFile, StepResult) {
             loads: vec![],
             contacts: vec![],
             fracture: None,
+            velocities: Vec::new(),
         }],
     };
     (model, step)
@@ -175,6 +177,7 @@ fn two_patches() -> (ModelFile, StepResult) {
     let step = StepResult {
         step: 1,
         load_factor: 1.0,
+        time: None,
         bodies: vec![BodyResult {
             name: "p".into(),
             displacements: vec![vec![0.0; 3]; 6],
@@ -187,6 +190,7 @@ fn two_patches() -> (ModelFile, StepResult) {
             loads: vec![],
             contacts: vec![],
             fracture: None,
+            velocities: Vec::new(),
         }],
     };
     (model, step)

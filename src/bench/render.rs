@@ -78,6 +78,7 @@ pub fn bent_shell(rings: usize, sectors: usize) -> Result<(ModelFile, Vec<StepRe
         StepResult {
             step: k,
             load_factor: factor,
+            time: None,
             bodies: vec![BodyResult {
                 name: "shell".to_string(),
                 displacements: disp.iter().map(|d| d.to_vec()).collect(),
@@ -97,6 +98,7 @@ pub fn bent_shell(rings: usize, sectors: usize) -> Result<(ModelFile, Vec<StepRe
                     .collect(),
                 contacts: Vec::new(),
                 fracture: None,
+                velocities: Vec::new(),
             }],
         }
     };

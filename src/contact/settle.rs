@@ -243,7 +243,7 @@ impl ContactSolver {
         let mut nodes = 0;
         for body in bodies {
             if with_inertia {
-                body.validate_with_inertia()
+                body.validate_moving()
             } else {
                 body.validate()
             }

@@ -343,13 +343,12 @@ impl Body {
         self.validate_held(true)
     }
 
-    /// [`Body::validate`] for a body with inertia (a time step): it needs no supports, its
-    /// mass holds it (a body may fly free).
-    pub fn validate_with_inertia(&self) -> Result<(), BodyError> {
+    /// [`Body::validate`] for a body in time: inertia holds it, so it needs no supports.
+    pub fn validate_moving(&self) -> Result<(), BodyError> {
         self.validate_held(false)
     }
 
-    /// [`Body::validate`], with the supports required (`needs_supports`) or not.
+    /// The checks of [`Body::validate`]; supports are required when `needs_supports`.
     fn validate_held(&self, needs_supports: bool) -> Result<(), BodyError> {
         let body = || self.name.clone();
         for m in &self.materials {

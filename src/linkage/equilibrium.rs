@@ -72,6 +72,23 @@ pub enum SolveError {
         /// Relative residual after each iteration of the last attempt.
         history: Vec<Real>,
     },
+    /// A time step did not converge even at the smallest step size (`[dynamics] time_step`
+    /// halved `halvings` times).
+    #[error("body '{body}': the time step from t = {time} s did not converge, even at {step:e} s ({halvings} halvings of [dynamics] time_step, the most allowed): {reason}; relative residuals of the last attempt: [{}]. Give a smaller time_step, raise [bodies.newton] max_iterations, or check for a member crushed through zero length", format_history(.history))]
+    TimeStepNotConverged {
+        /// Body name.
+        body: String,
+        /// Start of the step, s.
+        time: Real,
+        /// The last step size tried, s.
+        step: Real,
+        /// Halvings of the time step.
+        halvings: usize,
+        /// Why the last attempt failed.
+        reason: String,
+        /// Relative residual after each iteration of the last attempt.
+        history: Vec<Real>,
+    },
     /// The iterative solver did not converge and the direct solver would not fit in memory.
     #[error("body '{body}': conjugate gradients stopped at relative residual {residual:e} after {iterations} iterations ({when}), and the direct solver would need {needed_mb} MB of the {available_mb} MB available: raise [bodies.solver] max_iterations, loosen its tolerance, or check the body for a mechanism (nodes held by nothing)")]
     IterativeFailed {

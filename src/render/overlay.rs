@@ -57,6 +57,9 @@ pub struct Caption {
     pub last_step: usize,
     /// Load factor of the step.
     pub load_factor: Real,
+    /// Time of the state drawn, s (a dynamic scene: the title shows it instead of the load
+    /// factor).
+    pub time: Option<Real>,
     /// Largest displacement at this step, m.
     pub max_displacement: Real,
     /// Overloaded members at this step.
@@ -113,13 +116,22 @@ pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
     let big = 26.0 * ui;
     let small = 17.0 * ui;
     let x = 40.0 * ui;
-    let title = format!(
-        "{}  ·  step {} of {}  ·  load factor {}",
-        c.scene,
-        c.step,
-        c.last_step,
-        fmt_load(c.load_factor)
-    );
+    let title = match c.time {
+        Some(t) => format!(
+            "{}  ·  t = {}  ·  frame {} of {}",
+            c.scene,
+            format_si(t, "s"),
+            c.step,
+            c.last_step
+        ),
+        None => format!(
+            "{}  ·  step {} of {}  ·  load factor {}",
+            c.scene,
+            c.step,
+            c.last_step,
+            fmt_load(c.load_factor)
+        ),
+    };
     draw_text(&mut frame.pixmap, &title, x, 46.0 * ui, big, INK);
     let mut sub = format!("max |u| = {}", format_si(c.max_displacement, "m"));
     sub.push_str(&format!(

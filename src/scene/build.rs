@@ -11,6 +11,7 @@ use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::contact_pairs::friction_settings;
 use crate::scene::import::{read_model, NodeGroup};
 use crate::scene::inline_files::InlineFiles;
+use crate::scene::dynamics_settings::{dynamics_from, initial_velocity, BodyStart, VelocitySource};
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::prepared_body::prepared_geometry;
@@ -225,6 +226,18 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
         materials.push(material);
     }
     let density = densities(&spec).map_err(|(span, e)| at(span, e))?;
+    let mut dynamics = match &spec.dynamics {
+        Some(d) => Some(dynamics_from(d.get_ref()).map_err(|e| at(d.span(), e))?),
+        None => None,
+    };
+    if let Some(d) = &spec.dynamics {
+        if !spec.obstacles.is_empty() || spec.contact.is_some() {
+            return Err(at(
+                d.span(),
+                "[dynamics] with contact (obstacles or a [contact] table) is not yet supported: remove the obstacles and [contact], or remove [dynamics] for a quasi-static run".to_string(),
+            ));
+        }
+    }
     if spec.bodies.is_empty() {
         return Err(at(
             top,
@@ -238,11 +251,15 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
     let mut found = Vec::new();
     for b in &spec.bodies {
         let mut notes = BodyNotes::default();
+        let steps = match &dynamics {
+            Some(_) => None,
+            None => Some(spec.steps),
+        };
         let body = build_body(
             b,
             &materials,
             (text, path, files),
-            spec.steps,
+            steps,
             &at,
             &mut notes,
         )?;
@@ -263,7 +280,11 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
                 ),
             ));
         }
-        body.validate().map_err(|e| {
+        let valid = match dynamics {
+            Some(_) => body.validate_moving(),
+            None => body.validate(),
+        };
+        valid.map_err(|e| {
             let message = e.to_string();
             SceneError::At {
                 path: path.to_path_buf(),
@@ -277,7 +298,10 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
             }
         })?;
         let mut body = body;
-        add_self_weight(&mut body, &spec, &density).map_err(|e| at(0..0, e))?;
+        add_self_weight(&mut body, &spec, &density, dynamics.is_some()).map_err(|e| at(0..0, e))?;
+        if let Some(d) = dynamics.as_mut() {
+            d.bodies.push(body_start(b, &body, &spec, &density, &at)?);
+        }
         bodies.push(body);
     }
     let contact = contact_settings(spec.contact.as_ref().map(|c| c.get_ref()))
@@ -328,7 +352,8 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
         contact,
         contact_table: spec.contact.is_some(),
         name: spec.name,
-        steps: spec.steps,
+        steps: dynamics.as_ref().map_or(spec.steps, |d| d.frames),
+        dynamics,
         bodies,
         output,
         pictures,
@@ -365,6 +390,7 @@ fn add_self_weight(
     body: &mut Body,
     spec: &SceneSpec,
     density: &[Option<crate::Real>],
+    dynamic: bool,
 ) -> Result<(), String> {
     let Some(g) = &spec.gravity else {
         if spec.gravity_schedule.is_some() {
@@ -380,6 +406,11 @@ fn add_self_weight(
         return Err(format!("gravity = {g:?}: give finite numbers in m/s²"));
     }
     let schedule = match &spec.gravity_schedule {
+        None if dynamic => Schedule::Factors(vec![1.0]),
+        Some(f) if dynamic && f.is_empty() => {
+            return Err("gravity_schedule is empty: give at least one factor (factors stand at equally spaced times over [dynamics] duration)".to_string())
+        }
+        Some(f) if dynamic && f.iter().all(|v| v.is_finite()) => Schedule::Factors(f.clone()),
         None => Schedule::Linear,
         Some(f) if f.len() != spec.steps => {
             return Err(format!(
@@ -561,7 +592,7 @@ fn build_body(
     spanned: &Spanned<BodySpec>,
     materials: &[Material],
     (text, scene, files): (&str, &Path, &InlineFiles),
-    steps: usize,
+    steps: Option<usize>,
     at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
     notes: &mut BodyNotes,
 ) -> Result<Body, SceneError> {
@@ -876,16 +907,42 @@ fn build_body(
         }
     }
 
-    let schedule = |s: &Option<Vec<f64>>| -> Result<Schedule, String> {
-        match s {
-            None => Ok(Schedule::Linear),
-            Some(f) if f.len() != steps => Err(format!(
+    // In a dynamic scene (`steps` None) a schedule's factors stand at equally spaced times over
+    // the duration; without one a load is full from t = 0 and a support displacement is covered
+    // at constant speed.
+    let dynamic_default =
+        |load: bool| Schedule::Factors(if load { vec![1.0] } else { vec![0.0, 1.0] });
+    let schedule_of = |s: &Option<Vec<f64>>, load: bool| -> Result<Schedule, String> {
+        match (s, steps) {
+            (None, None) => Ok(dynamic_default(load)),
+            (None, Some(_)) => Ok(Schedule::Linear),
+            (Some(f), None) if f.is_empty() => Err(
+                "`schedule` is empty: give at least one factor (they stand at equally spaced times over [dynamics] duration)".to_string(),
+            ),
+            (Some(f), None) => Ok(Schedule::Factors(f.clone())),
+            (Some(f), Some(steps)) if f.len() != steps => Err(format!(
                 "`schedule` has {} factors but the scene has {steps} steps: give one factor per step",
                 f.len()
             )),
-            Some(f) => Ok(Schedule::Factors(f.clone())),
+            (Some(f), Some(_)) => Ok(Schedule::Factors(f.clone())),
         }
     };
+    if steps.is_some() {
+        let key = if spec.velocity.is_some() {
+            Some("velocity")
+        } else if spec.angular_velocity.is_some() {
+            Some("angular_velocity")
+        } else if !spec.velocities.is_empty() {
+            Some("velocities")
+        } else {
+            None
+        };
+        if let Some(key) = key {
+            return Err(here(format!(
+                "`{key}` is an initial velocity, for a scene solved in time: add a [dynamics] table (duration, time_step) or remove it"
+            )));
+        }
+    }
     let d = body.dimension.dofs_per_node();
     for s in &spec.supports {
         let sp = s.get_ref();
@@ -924,7 +981,7 @@ fn build_body(
                 ["x", "y", "z"][k]
             )));
         }
-        let schedule = schedule(&sp.schedule).map_err(fail)?;
+        let schedule = schedule_of(&sp.schedule, false).map_err(fail)?;
         for node in nodes {
             body.supports.push(Support {
                 node,
@@ -1005,7 +1062,7 @@ fn build_body(
         notes.warnings.extend(
             partly_held_warning(key, force, nodes.len(), &lost, d).map(|w| fail(w).to_string()),
         );
-        let schedule = schedule(&lp.schedule).map_err(fail)?;
+        let schedule = schedule_of(&lp.schedule, true).map_err(fail)?;
         for node in nodes {
             body.loads.push(NodalLoad {
                 node,
@@ -1016,7 +1073,7 @@ fn build_body(
     }
     for p in &spec.pressures {
         let fail = |m: String| at(p.span(), format!("body '{}': pressure: {m}", spec.name));
-        let schedule = schedule(&p.get_ref().schedule).map_err(fail)?;
+        let schedule = schedule_of(&p.get_ref().schedule, true).map_err(fail)?;
         add_pressure(&mut body, p.get_ref(), schedule, &groups).map_err(fail)?;
     }
     Ok(body)
@@ -1056,4 +1113,34 @@ fn partly_held_warning(
         v(applied),
         v(carried),
     ))
+}
+
+/// A dynamic scene's body: its lumped mass (a material without density is reported at its
+/// `[[materials]]` entry) and initial velocity (reported at the key or entry that gives it).
+fn body_start(
+    spanned: &Spanned<BodySpec>,
+    body: &Body,
+    spec: &SceneSpec,
+    density: &[Option<crate::Real>],
+    at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
+) -> Result<BodyStart, SceneError> {
+    let mass = crate::linkage::dynamics::lumped_mass(body, density).map_err(|e| {
+        let span = match &e {
+            crate::linkage::dynamics::MassError::NoDensity { material, .. } => spec
+                .materials
+                .iter()
+                .find(|m| &m.get_ref().name == material)
+                .map_or(spanned.span(), |m| m.span()),
+            _ => spanned.span(),
+        };
+        at(span, format!("{e}; add `density` to the material"))
+    })?;
+    let velocity = initial_velocity(spanned.get_ref(), body, &mass).map_err(|(source, e)| {
+        let span = match source {
+            VelocitySource::Body => spanned.span(),
+            VelocitySource::Entry(k) => spanned.get_ref().velocities[k].span(),
+        };
+        at(span, format!("body '{}': {e}", body.name))
+    })?;
+    Ok(BodyStart { mass, velocity })
 }

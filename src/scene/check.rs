@@ -3,7 +3,6 @@
 
 use crate::scene::results::BodySize;
 use crate::scene::run_error::RunError;
-use crate::scene::simulation::Simulation;
 use crate::scene::{OutputSettings, ResultFormat, World};
 use std::path::PathBuf;
 
@@ -33,11 +32,11 @@ pub struct CheckReport {
 }
 
 /// Every check `linkage run` makes before its first load step, with the same errors: the
-/// solvers are built as the run builds them ([`Simulation::new`]: validation, assembly,
+/// solvers are built as the run builds them ([`crate::scene::Simulation::new`], or [`crate::scene::DynamicSimulation::new`] in time: validation, assembly,
 /// factorization, mechanisms and rigid motions left free by the supports of linear bodies,
 /// contact surfaces, bodies starting inside obstacles or each other). Nothing is written.
 pub fn check_world(world: &World) -> Result<CheckReport, RunError> {
-    let simulation = Simulation::new(world)?;
+    let simulation = crate::scene::Stepper::new(world)?;
     let mut notes = Vec::new();
     for body in world.bodies.iter().filter(|b| b.is_nonlinear()) {
         notes.push(format!(

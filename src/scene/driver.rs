@@ -7,8 +7,8 @@ use crate::scene::publish::{destination, publish, remove_stale, staging_dir};
 use crate::scene::results::{PhaseSeconds, StepResult, Summary, SummaryBreak};
 use crate::scene::run_error::RunError;
 use crate::scene::run_results::step_digits;
-use crate::scene::simulation::Simulation;
 use crate::scene::step_writer::StepWriter;
+use crate::scene::stepper::Stepper;
 use crate::scene::writers::{keeps_steps, write_after_steps, write_json, write_model, DrawResults};
 use crate::scene::World;
 use std::path::Path;
@@ -88,16 +88,13 @@ fn run_in(
     // written, which on a million-member body takes half a second off the run's wall time.
     std::thread::scope(|scope| {
         let started = Instant::now();
-        let mut simulation =
-            Simulation::new(world).map_err(
-                |e| {
-                    if stop.is_raised() {
-                        interrupted(0)
-                    } else {
-                        e
-                    }
-                },
-            )?;
+        let mut simulation = Stepper::new(world).map_err(|e| {
+            if stop.is_raised() {
+                interrupted(0)
+            } else {
+                e
+            }
+        })?;
         let setup = started.elapsed().as_secs_f64();
         // Not before the set-up: that is where the run's memory peaks.
         let model_file = scope.spawn(|| write_model(world, staging));
@@ -157,7 +154,7 @@ pub fn run_in_memory(
 ) -> Result<(Summary, Vec<StepResult>, Option<RunError>), RunError> {
     let started = Instant::now();
     let stop = world.interrupt();
-    let mut simulation = Simulation::new(world).map_err(|e| {
+    let mut simulation = Stepper::new(world).map_err(|e| {
         if stop.is_raised() {
             RunError::Interrupted {
                 scene: world.source.clone(),
@@ -185,7 +182,7 @@ pub fn run_in_memory(
 }
 
 /// The summary of a run about to be solved with `simulation`: no steps yet.
-fn start_summary(world: &World, simulation: &Simulation) -> Summary {
+fn start_summary(world: &World, simulation: &Stepper) -> Summary {
     Summary {
         scene: world.name.clone(),
         steps: Vec::with_capacity(world.steps + 1),
@@ -203,7 +200,7 @@ fn start_summary(world: &World, simulation: &Simulation) -> Summary {
 }
 
 /// Add the solvers' time (assembly, factorizations, solves, contact queries) to the summary.
-fn add_solver_times(summary: &mut Summary, simulation: &Simulation) {
+fn add_solver_times(summary: &mut Summary, simulation: &Stepper) {
     let (times, query) = simulation.times();
     summary.phases.assembly += times.assembly;
     summary.phases.symbolic += times.symbolic;
@@ -219,13 +216,13 @@ fn add_solver_times(summary: &mut Summary, simulation: &Simulation) {
 /// as a result; a step after step 0 that cannot be solved ends it with the summary's `failure`
 /// set and the error returned as `Ok(Some(..))`; step 0's error is returned as `Err`.
 fn solve_steps(
-    simulation: &mut Simulation,
+    simulation: &mut Stepper,
     summary: &mut Summary,
     setup: f64,
     on_step: &(dyn Fn() + Sync),
     store: &mut dyn FnMut(StepResult) -> bool,
 ) -> Result<Option<RunError>, RunError> {
-    let world = simulation.world;
+    let world = simulation.world();
     let stop = world.interrupt();
     let interrupted = |step: usize| RunError::Interrupted {
         scene: world.source.clone(),

@@ -253,11 +253,13 @@ pub(crate) fn read_step_npz(bytes: &[u8], model: &ModelFile) -> Result<StepResul
             loads,
             contacts,
             fracture: None,
+            velocities: Vec::new(),
         });
     }
     Ok(StepResult {
         step,
         load_factor,
+        time: None,
         bodies,
     })
 }
@@ -492,6 +494,7 @@ mod tests {
         StepResult {
             step: 7,
             load_factor: 0.7000000000000001,
+            time: None,
             bodies: vec![
                 BodyResult {
                     name: "a body/with spaces".into(),
@@ -518,6 +521,7 @@ mod tests {
                         slip: vec![tricky[2], 0.0],
                     }],
                     fracture: None,
+                    velocities: Vec::new(),
                 },
                 BodyResult {
                     name: "3d".into(),
@@ -534,6 +538,7 @@ mod tests {
                     }],
                     contacts: vec![],
                     fracture: None,
+                    velocities: Vec::new(),
                 },
             ],
         }

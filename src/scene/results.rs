@@ -68,6 +68,9 @@ pub struct BodyResult {
     /// `broken`, `breaks` and `fallen`: a body with breaking members only.
     #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
     pub fracture: Option<BodyFracture>,
+    /// Velocity per node, m/s (a dynamic scene; absent otherwise).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub velocities: Vec<Vec<Real>>,
 }
 
 /// One break as written: the member and the load factor at which it broke.
@@ -146,8 +149,46 @@ pub struct StepResult {
     pub step: usize,
     /// Load factor of the step.
     pub load_factor: Real,
+    /// Time of the stored state, s (a dynamic scene; absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time: Option<Real>,
     /// Every body of the scene, in scene order.
     pub bodies: Vec<BodyResult>,
+}
+
+/// The energies of a dynamic scene at one stored state, all bodies, J.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StepEnergy {
+    /// Time of the state, s.
+    pub time: Real,
+    /// `½ vᵀ M v`, J.
+    pub kinetic_energy: Real,
+    /// Strain energy of the members, J.
+    pub strain_energy: Real,
+    /// Work of the applied forces (gravity included) and of the moving supports since t = 0, J.
+    pub external_work: Real,
+    /// Energy dissipated since t = 0 (Rayleigh damping), J.
+    pub dissipated: Real,
+    /// The balance `kinetic + strain − external_work + dissipated`, J: constant for an
+    /// integrator that conserves energy; its drift is the integrator's numerical dissipation.
+    pub total_energy: Real,
+    /// Time steps taken since the previous stored state.
+    pub time_steps: usize,
+    /// The smallest time step taken since the previous stored state, s.
+    pub smallest_time_step: Real,
+    /// Per body, in scene order, its momenta.
+    pub momenta: Vec<BodyMomentum>,
+}
+
+/// The momenta of one body at one stored state.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BodyMomentum {
+    /// Body name.
+    pub body: String,
+    /// `Σ m v`, kg·m/s, one component per dimension.
+    pub momentum: Vec<Real>,
+    /// `Σ m x × v` about the origin, kg·m²/s (2D: the z component alone).
+    pub angular_momentum: Vec<Real>,
 }
 
 /// One line of `summary.json`'s `steps`.
@@ -214,6 +255,9 @@ pub struct StepSummary {
     /// material has one (absent when none has).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stress_ratio: Option<Real>,
+    /// `time`, the energies and the momenta of a dynamic scene (absent otherwise).
+    #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
+    pub dynamics: Option<StepEnergy>,
 }
 
 /// Size of one body, as reported in `summary.json`.
@@ -333,6 +377,7 @@ impl BodyResult {
             loads: node_forces(&state.loads),
             contacts: Vec::new(),
             fracture: None,
+            velocities: Vec::new(),
         }
     }
 

@@ -162,6 +162,7 @@ impl<'w> Simulation<'w> {
         let mut result = StepResult {
             step,
             load_factor: summary.load_factor,
+            time: None,
             bodies: Vec::with_capacity(world.bodies.len()),
         };
         for (k, (body, state)) in world.bodies.iter().zip(&states).enumerate() {
@@ -579,7 +580,7 @@ fn residual_warnings(bodies: &[Body], step: usize, states: &[StepState]) -> Vec<
 }
 
 /// The summary line of `step` before anything is solved.
-fn empty_summary(step: usize, load_factor: Real) -> StepSummary {
+pub(crate) fn empty_summary(step: usize, load_factor: Real) -> StepSummary {
     StepSummary {
         step,
         load_factor,
@@ -602,6 +603,7 @@ fn empty_summary(step: usize, load_factor: Real) -> StepSummary {
         broken: None,
         peak_stress: None,
         stress_ratio: None,
+        dynamics: None,
     }
 }
 

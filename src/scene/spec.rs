@@ -38,6 +38,60 @@ pub struct SceneSpec {
     /// Factor of `gravity` per step 1..=steps (default: linear ramp, full weight at the last
     /// step), as a load's `schedule`.
     pub gravity_schedule: Option<Vec<Real>>,
+    /// `[dynamics]`: the scene is solved in time, with inertia (see `docs/SCENES.md`).
+    pub dynamics: Option<Spanned<DynamicsSpec>>,
+}
+
+/// `[dynamics]`: time integration settings.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsSpec {
+    /// Simulated time, s (> 0).
+    pub duration: Real,
+    /// The largest time step, s (> 0); halved where Newton needs it, regrown after.
+    pub time_step: Real,
+    /// Stored states after t = 0, evenly spaced in time (default: every time step).
+    pub frames: Option<usize>,
+    /// `"energy_momentum"` (default), `"newmark"`, `"generalized_alpha"` or `"backward_euler"`.
+    pub integrator: Option<String>,
+    /// Newmark β (default ¼), > 0.
+    pub beta: Option<Real>,
+    /// Newmark γ (default ½), ≥ ½.
+    pub gamma: Option<Real>,
+    /// Generalized-α spectral radius at infinite frequency ρ∞ (default 0.8), in [0, 1].
+    pub rho_inf: Option<Real>,
+    /// Rayleigh damping `{ mass = α (1/s), stiffness = β (s) }`.
+    pub damping: Option<DampingSpec>,
+}
+
+/// `damping = { mass, stiffness }` of `[dynamics]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DampingSpec {
+    /// α, 1/s (≥ 0).
+    pub mass: Option<Real>,
+    /// β, s (≥ 0).
+    pub stiffness: Option<Real>,
+}
+
+/// `[[bodies.velocities]]`: the initial velocity of selected nodes (a dynamic scene).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VelocitySpec {
+    /// 1-based node numbers.
+    pub nodes: Option<Vec<i64>>,
+    /// See [`SelectorSpec`].
+    pub nearest: Option<Vec<Real>>,
+    /// See [`SelectorSpec`].
+    pub inside: Option<BoxSpec>,
+    /// See [`SelectorSpec`].
+    pub on_line: Option<LineSpec>,
+    /// See [`SelectorSpec`].
+    pub on_plane: Option<PlaneSpec>,
+    /// See [`SelectorSpec`].
+    pub tolerance: Option<Real>,
+    /// Initial velocity of each selected node, m/s, one component per direction.
+    pub velocity: Vec<Real>,
 }
 
 /// `[contact]`: penalty and tolerances (see `docs/SCENES.md`).
@@ -242,6 +296,15 @@ pub struct BodySpec {
     /// Pressures on surface patches.
     #[serde(default)]
     pub pressures: Vec<Spanned<PressureSpec>>,
+    /// Initial velocity of every node, m/s (a dynamic scene).
+    pub velocity: Option<Vec<Real>>,
+    /// Initial angular velocity about the body's centre of mass, rad/s: one number in 2D
+    /// (about z), three in 3D (a dynamic scene).
+    #[serde(default, deserialize_with = "number_or_list")]
+    pub angular_velocity: Option<Vec<Real>>,
+    /// Initial velocities of selected nodes, after `velocity` and `angular_velocity`.
+    #[serde(default)]
+    pub velocities: Vec<Spanned<VelocitySpec>>,
 }
 
 /// `[bodies.newton]`: convergence settings of the Newton solve (see `docs/SCENES.md`).
@@ -563,3 +626,4 @@ macro_rules! selector_of {
 selector_of!(SupportSpec, group);
 selector_of!(LoadSpec, group);
 selector_of!(PressureSpec, group);
+selector_of!(VelocitySpec);

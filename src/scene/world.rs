@@ -39,8 +39,10 @@ impl OutputSettings {
 pub struct World {
     /// Scene name: the output folder.
     pub name: String,
-    /// Number of load steps.
+    /// Number of load steps; in a dynamic scene the stored frames after t = 0.
     pub steps: usize,
+    /// `[dynamics]`: the scene is solved in time (`None`: quasi-static load steps).
+    pub dynamics: Option<crate::scene::dynamics_settings::DynamicsSettings>,
     /// The deformable bodies.
     pub bodies: Vec<Body>,
     /// Rigid obstacles (`[[obstacles]]`).
