@@ -42,7 +42,7 @@ impl Drop for Running {
 const WATCH: Duration = Duration::from_millis(50);
 
 /// What the solve thread hands back: the results, or why there are none.
-type Solved = Result<Results, RunFailure>;
+type Solved = Result<Results, Box<RunFailure>>;
 
 /// A run that stopped: the library's error and, in memory, the steps solved before it.
 pub struct RunFailure {
@@ -124,6 +124,7 @@ pub fn run_world(
     let solved = outcome?;
     report(py, &mut reported)?;
     solved.map_err(|failure| {
+        let failure = *failure;
         let err = run_error(&failure.error);
         if let Some(results) = failure.results {
             let _ = err.value(py).setattr("results", Py::new(py, results).ok());
@@ -141,9 +142,11 @@ fn solve(world: &World, out: Option<PathBuf>, done: &AtomicUsize) -> Solved {
     };
     match out {
         Some(out) => {
-            let fail = |error| RunFailure {
-                error,
-                results: None,
+            let fail = |error| {
+                Box::new(RunFailure {
+                    error,
+                    results: None,
+                })
             };
             std::fs::create_dir_all(&out).map_err(|source| {
                 fail(RunError::Write {
@@ -162,14 +165,14 @@ fn solve(world: &World, out: Option<PathBuf>, done: &AtomicUsize) -> Solved {
         }
         None => match run_in_memory(world, &on_step) {
             Ok((summary, steps, None)) => Ok(Results::new(steps, Some(summary), None)),
-            Ok((summary, steps, Some(error))) => Err(RunFailure {
+            Ok((summary, steps, Some(error))) => Err(Box::new(RunFailure {
                 error,
                 results: Some(Results::new(steps, Some(summary), None)),
-            }),
-            Err(error) => Err(RunFailure {
+            })),
+            Err(error) => Err(Box::new(RunFailure {
                 error,
                 results: None,
-            }),
+            })),
         },
     }
 }
