@@ -12,7 +12,7 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
@@ -540,7 +540,6 @@ fn run_sweep(path: &Path, out: &Path) -> Outcome {
     if built.iter().any(is_too_large) {
         return Outcome::TooLarge;
     }
-    let stop = AtomicBool::new(false);
     let ran = jobs
         .iter()
         .map(|job| {
@@ -551,7 +550,7 @@ fn run_sweep(path: &Path, out: &Path) -> Outcome {
                 None,
                 &|_: &World| {},
                 &|| {},
-                &stop,
+                linkage::linkage::Interrupt::default(),
             );
             (job.folder(out), matches!(ran, batch::Ran::Solved { .. }))
         })

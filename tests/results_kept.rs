@@ -195,7 +195,7 @@ fn stops_cleanly_on(signal: &str) {
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(stderr.contains("interrupted: stopping"), "{stderr}");
     assert!(
-        stdout.contains("interrupted before step") && stdout.contains("no results written"),
+        stdout.contains("interrupted at step") && stdout.contains("no results written"),
         "{stdout}"
     );
     // The batch table says the run failed.

@@ -441,6 +441,7 @@ fn nearest(p: [f64; 2]) -> linkage::scene::spec::SelectorSpec {
         on_line: None,
         on_plane: None,
         tolerance: None,
+        group: None,
     }
 }
 

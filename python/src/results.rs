@@ -163,7 +163,7 @@ impl Step {
     /// Time of the step, s, in a dynamic scene; None in a quasi-static one.
     #[getter]
     fn time(&self) -> Option<f64> {
-        None
+        self.result().time
     }
 
     /// The names of the bodies, in scene order.

@@ -9,8 +9,8 @@
 
 use crate::errors::run_error;
 use crate::results::Results;
-use linkage::render::PictureWriter;
 use linkage::linkage::Interrupt;
+use linkage::render::PictureWriter;
 use linkage::scene::{run_in_memory, run_with, RunError, World};
 use pyo3::prelude::*;
 use std::path::PathBuf;

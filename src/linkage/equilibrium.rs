@@ -86,8 +86,9 @@ pub enum SolveError {
         halvings: usize,
         /// Why the last attempt failed.
         reason: String,
-        /// Relative residual after each iteration of the last attempt.
-        history: Vec<Real>,
+        /// Relative residual after each iteration of the last attempt (boxed: the variant then
+        /// stays smaller than [`SolveError::NotConverged`], so the error stays small).
+        history: Box<[Real]>,
     },
     /// The iterative solver did not converge and the direct solver would not fit in memory.
     #[error("body '{body}': conjugate gradients stopped at relative residual {residual:e} after {iterations} iterations ({when}), and the direct solver would need {needed_mb} MB of the {available_mb} MB available: raise [bodies.solver] max_iterations, loosen its tolerance, or check the body for a mechanism (nodes held by nothing)")]

@@ -16,8 +16,7 @@ pub const FRAME_RATE: Real = 10.0;
 /// version hold none (quasi-static runs); when a dynamic run's steps gain `time`, this returns
 /// it, and every animation follows it.
 pub fn stored_time(step: &StepResult) -> Option<Real> {
-    let _ = step;
-    None
+    step.time
 }
 
 /// How much of a run an animation may hold: long or large runs keep evenly spaced frames.
@@ -456,9 +455,11 @@ mod tests {
                 let u = k as Real * 1e-3;
                 StepResult {
                     step: k,
+                    time: None,
                     load_factor: k as Real / (n - 1).max(1) as Real,
                     bodies: vec![BodyResult {
                         name: "bar".into(),
+                        velocities: vec![],
                         displacements: vec![vec![0.0, 0.0], vec![0.0, 0.0], vec![u, 0.0]],
                         positions: vec![vec![0.0, 0.0], vec![1.0, 0.0], vec![2.0 + u, 0.0]],
                         axial_forces: vec![0.0, 0.0],

@@ -9,9 +9,9 @@ use crate::linkage::{
 };
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::contact_pairs::friction_settings;
+use crate::scene::dynamics_settings::{dynamics_from, initial_velocity, BodyStart, VelocitySource};
 use crate::scene::import::{read_model, NodeGroup};
 use crate::scene::inline_files::InlineFiles;
-use crate::scene::dynamics_settings::{dynamics_from, initial_velocity, BodyStart, VelocitySource};
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
 use crate::scene::prepared_body::prepared_geometry;
@@ -255,14 +255,7 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
             Some(_) => None,
             None => Some(spec.steps),
         };
-        let body = build_body(
-            b,
-            &materials,
-            (text, path, files),
-            steps,
-            &at,
-            &mut notes,
-        )?;
+        let body = build_body(b, &materials, (text, path, files), steps, &at, &mut notes)?;
         if let Some(r) = notes.report {
             prepared.insert(body.name.clone(), r);
         }

@@ -88,13 +88,8 @@ fn run_in(
     // written, which on a million-member body takes half a second off the run's wall time.
     std::thread::scope(|scope| {
         let started = Instant::now();
-        let mut simulation = Stepper::new(world).map_err(|e| {
-            if stop.is_raised() {
-                interrupted(0)
-            } else {
-                e
-            }
-        })?;
+        let mut simulation =
+            Stepper::new(world).map_err(|e| if stop.is_raised() { interrupted(0) } else { e })?;
         let setup = started.elapsed().as_secs_f64();
         // Not before the set-up: that is where the run's memory peaks.
         let model_file = scope.spawn(|| write_model(world, staging));
@@ -104,9 +99,13 @@ fn run_in(
         // Every file name of the run has enough digits for its last step, so they sort.
         let digits = step_digits(world.steps);
         let writer = StepWriter::start(scope, world, &steps_dir, digits, keep);
-        let stepped = solve_steps(&mut simulation, &mut summary, setup, on_step, &mut |result| {
-            writer.write(result)
-        });
+        let stepped = solve_steps(
+            &mut simulation,
+            &mut summary,
+            setup,
+            on_step,
+            &mut |result| writer.write(result),
+        );
         let finished = writer.finish();
         let stopped = stepped?;
         let (kept, writing) = finished?;

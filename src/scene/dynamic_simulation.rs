@@ -187,7 +187,7 @@ impl<'w> DynamicSimulation<'w> {
                                     step: h,
                                     halvings: self.depth,
                                     reason: failure.reason,
-                                    history: failure.history,
+                                    history: failure.history.into_boxed_slice(),
                                 },
                             });
                         }

@@ -6,8 +6,8 @@ use crate::contact::{
 };
 use crate::linkage::fracture::{breaks_members, BreakEvent, FractureState};
 use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
-use crate::scene::contact_concentration::concentrated_contact_warnings;
 use crate::scene::capacity::CapacityWatch;
+use crate::scene::contact_concentration::concentrated_contact_warnings;
 use crate::scene::instability::InstabilityWatch;
 use crate::scene::results::{
     BodyFracture, BodyResult, BodySize, BreakRecord, Collapse, ContactForce, PairForce, StepResult,

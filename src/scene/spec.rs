@@ -43,7 +43,7 @@ pub struct SceneSpec {
 }
 
 /// `[dynamics]`: time integration settings.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DynamicsSpec {
     /// Simulated time, s (> 0).
@@ -65,7 +65,7 @@ pub struct DynamicsSpec {
 }
 
 /// `damping = { mass, stiffness }` of `[dynamics]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DampingSpec {
     /// α, 1/s (≥ 0).
@@ -75,7 +75,7 @@ pub struct DampingSpec {
 }
 
 /// `[[bodies.velocities]]`: the initial velocity of selected nodes (a dynamic scene).
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct VelocitySpec {
     /// 1-based node numbers.
