@@ -257,14 +257,18 @@ fn bundled_scenes() -> Vec<Scene> {
         .collect()
 }
 
-/// `steps = N` → at most [`STEPS`], and every `schedule = [...]` cut to as many factors.
+/// `steps = N` (and a dynamic scene's `frames = N`) → at most [`STEPS`], and every
+/// `schedule = [...]` cut to as many factors.
 fn cap_steps(text: &str) -> String {
     let mut out = String::new();
     for line in text.lines() {
         let trimmed = line.trim_start();
-        if let Some(value) = trimmed.strip_prefix("steps = ") {
+        let capped = ["steps = ", "frames = "]
+            .into_iter()
+            .find_map(|key| trimmed.strip_prefix(key).map(|value| (key, value)));
+        if let Some((key, value)) = capped {
             let n: usize = value.split('#').next().unwrap().trim().parse().unwrap();
-            out.push_str(&format!("steps = {}\n", n.min(STEPS)));
+            out.push_str(&format!("{key}{}\n", n.min(STEPS)));
         } else if let Some(list) = trimmed.strip_prefix("schedule = [") {
             let list = list.split(']').next().unwrap();
             let factors: Vec<&str> = list.split(',').map(str::trim).take(STEPS).collect();

@@ -323,6 +323,11 @@ fn every_bundled_scene_is_in_equilibrium() {
     assert!(scenes.len() >= 5);
     for path in scenes {
         let world = load_scene(&path).unwrap();
+        // A dynamic scene's forces balance its inertia, not each other: tests/dynamics.rs
+        // checks its energy and momenta instead.
+        if world.dynamics.is_some() {
+            continue;
+        }
         let mut sim = Simulation::new(&world).unwrap();
         // The balance is measured against the largest force the run has carried so far: once
         // a body has broken apart (wedge_split's last steps) its forces fall by orders of
