@@ -1,6 +1,7 @@
 //! Self-weight lumped to the nodes: each member's weight ρ A L g shared half and half by its
 //! two end nodes (the lumped masses ρAL/2 per member end).
 
+use crate::linkage::dynamics::node_masses;
 use crate::linkage::{Body, NodalLoad, Schedule};
 use crate::Real;
 use nalgebra::Vector3;
@@ -15,17 +16,7 @@ pub fn self_weight_loads(
     gravity: Vector3<Real>,
     schedule: &Schedule,
 ) -> Vec<NodalLoad> {
-    let mut mass = vec![0.0; body.nodes.len()];
-    for m in &body.members {
-        let Some(rho) = density.get(m.material).copied().flatten() else {
-            continue;
-        };
-        let [a, b] = m.nodes;
-        let length = (body.nodes[b] - body.nodes[a]).norm();
-        let half = 0.5 * rho * body.materials[m.material].area * length;
-        mass[a] += half;
-        mass[b] += half;
-    }
+    let mass = node_masses(body, density);
     mass.iter()
         .enumerate()
         .filter(|(_, &m)| m > 0.0)

@@ -30,23 +30,20 @@ pub enum MassError {
 /// round-off. Every material a member uses needs a density > 0, and every node a member.
 pub fn lumped_mass(body: &Body, density: &[Option<Real>]) -> Result<Vec<Real>, MassError> {
     let d = body.dimension.dofs_per_node();
-    let mut node_mass = vec![0.0; body.nodes.len()];
     for m in &body.members {
-        let rho = match density.get(m.material).copied().flatten() {
-            Some(rho) if rho.is_finite() && rho > 0.0 => rho,
-            _ => {
-                return Err(MassError::NoDensity {
-                    body: body.name.clone(),
-                    material: body.materials[m.material].name.clone(),
-                })
-            }
-        };
-        let [a, b] = m.nodes;
-        let length = (body.nodes[b] - body.nodes[a]).norm();
-        let half = 0.5 * rho * body.materials[m.material].area * length;
-        node_mass[a] += half;
-        node_mass[b] += half;
+        if !density
+            .get(m.material)
+            .copied()
+            .flatten()
+            .is_some_and(|rho| rho.is_finite() && rho > 0.0)
+        {
+            return Err(MassError::NoDensity {
+                body: body.name.clone(),
+                material: body.materials[m.material].name.clone(),
+            });
+        }
     }
+    let node_mass = node_masses(body, density);
     if let Some(node) = node_mass.iter().position(|&m| m <= 0.0) {
         return Err(MassError::Massless {
             body: body.name.clone(),
@@ -57,6 +54,24 @@ pub fn lumped_mass(body: &Body, density: &[Option<Real>]) -> Result<Vec<Real>, M
         .iter()
         .flat_map(|&m| std::iter::repeat_n(m, d))
         .collect())
+}
+
+/// Per node of `body` the sum over its members of `ρ A L / 2`, kg (`L` the undeformed length,
+/// `density[k]` in kg/m³ that of `body.materials[k]`; a member of a material without density
+/// weighs nothing): the lumped masses both the inertia and the self-weight use.
+pub fn node_masses(body: &Body, density: &[Option<Real>]) -> Vec<Real> {
+    let mut mass = vec![0.0; body.nodes.len()];
+    for m in &body.members {
+        let Some(rho) = density.get(m.material).copied().flatten() else {
+            continue;
+        };
+        let [a, b] = m.nodes;
+        let length = (body.nodes[b] - body.nodes[a]).norm();
+        let half = 0.5 * rho * body.materials[m.material].area * length;
+        mass[a] += half;
+        mass[b] += half;
+    }
+    mass
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ pub use self::energy_momentum::EnergyMomentum;
 pub use self::generalized_alpha::GeneralizedAlpha;
 pub use self::inertia::InertiaTerm;
 pub use self::integrator::{Integrator, Motion, StepForm};
-pub use self::lumped_mass::{lumped_mass, MassError};
+pub use self::lumped_mass::{lumped_mass, node_masses, MassError};
 pub use self::newmark::Newmark;
 pub use self::rayleigh::RayleighDamping;
 pub use self::time_schedule::{loads_at_time, prescribed_at_time, time_factor};
