@@ -1,5 +1,6 @@
 //! Backward (implicit) Euler: first order, strongly damping.
 
+use crate::linkage::dynamics::integrator::advanced;
 use crate::linkage::dynamics::{InertiaTerm, Integrator, Motion, StepForm};
 use crate::Real;
 
@@ -15,27 +16,28 @@ impl Integrator for BackwardEuler {
     }
 
     fn form(&self, start: &Motion, mass: &[Real], h: Real) -> StepForm {
+        let predictor_increment: Vec<Real> = start.v.iter().map(|v| h * v).collect();
         StepForm {
             blend: 1.0,
             inertia: InertiaTerm {
                 mass: mass.to_vec(),
                 coefficient: 1.0 / (h * h),
-                predictor: start
-                    .u
-                    .iter()
-                    .zip(&start.v)
-                    .map(|(u, v)| u + h * v)
-                    .collect(),
+                predictor: advanced(start, &predictor_increment),
             },
+            predictor_increment,
             velocity_coefficient: 1.0 / h,
-            velocity_predictor: start.u.clone(),
+            velocity_predictor: vec![0.0; start.u.len()],
             discrete_gradient: false,
         }
     }
 
-    fn finish(&self, start: &Motion, u: Vec<Real>, h: Real) -> Motion {
-        let v: Vec<Real> = u.iter().zip(&start.u).map(|(a, b)| (a - b) / h).collect();
+    fn finish(&self, start: &Motion, du: Vec<Real>, h: Real) -> Motion {
+        let v: Vec<Real> = du.iter().map(|d| d / h).collect();
         let a = v.iter().zip(&start.v).map(|(a, b)| (a - b) / h).collect();
-        Motion { u, v, a }
+        Motion {
+            u: advanced(start, &du),
+            v,
+            a,
+        }
     }
 }

@@ -5,6 +5,7 @@ use crate::linkage::body_state::{internal_forces, member_response_at, norm};
 use crate::linkage::dynamics::discrete_gradient::{
     discrete_gradient_block, discrete_gradient_forces,
 };
+use crate::linkage::dynamics::integrator::advanced;
 use crate::linkage::dynamics::time_schedule::{loads_at_time, prescribed_at_time};
 use crate::linkage::dynamics::{Integrator, Motion, RayleighDamping, StepForm};
 use crate::linkage::step_state::post_process;
@@ -192,39 +193,33 @@ impl BodyMotion {
         }
     }
 
-    /// The forces of the step `form` at configuration `y` (per body DOF, m), from `start` with
-    /// the applied forces `applied` at the evaluation time.
-    fn forces(&self, body: &Body, form: &StepForm, y: &[Real], applied: &[Real]) -> Forces {
-        let n = y.len();
+    /// The forces of the step `form` at the increment `w = y − u_n` of its configuration (per
+    /// body DOF, m) from the motion's `u_n`, with the applied forces `applied` at the
+    /// evaluation time. The inertia and damping terms are formed from `w` alone (no round-off
+    /// of the size of `|u_n|`).
+    fn forces(&self, body: &Body, form: &StepForm, w: &[Real], applied: &[Real]) -> Forces {
+        let n = w.len();
         let start = &self.motion.u;
+        let y = advanced(&self.motion, w);
         let mut internal = vec![0.0; n];
         if form.discrete_gradient {
-            let b = form.blend;
-            let u1: Vec<Real> = y
-                .iter()
-                .zip(start)
-                .map(|(y, u)| (y - (1.0 - b) * u) / b)
-                .collect();
+            let u1 = self.step_end(form, w);
             discrete_gradient_forces(body, start, &u1, &mut internal);
         } else {
-            internal_forces(body, y, &mut internal);
+            internal_forces(body, &y, &mut internal);
         }
         let mut damping = vec![0.0; n];
         if !self.damping.is_none() {
-            let v: Vec<Real> = y
+            let v: Vec<Real> = w
                 .iter()
                 .zip(&form.velocity_predictor)
-                .map(|(y, p)| form.velocity_coefficient * (y - p))
+                .map(|(w, p)| form.velocity_coefficient * (w - p))
                 .collect();
-            self.damping_forces(body, y, &v, &mut damping);
+            self.damping_forces(body, &y, &v, &mut damping);
         }
-        // c M (y − p), formed from the increments over u_n to keep the round-off small.
         let c = form.inertia.coefficient;
         let inertia = (0..n)
-            .map(|i| {
-                c * form.inertia.mass[i]
-                    * ((y[i] - start[i]) - (form.inertia.predictor[i] - start[i]))
-            })
+            .map(|i| c * form.inertia.mass[i] * (w[i] - form.predictor_increment[i]))
             .collect();
         Forces {
             applied: applied.to_vec(),
@@ -234,13 +229,19 @@ impl BodyMotion {
         }
     }
 
+    /// `u_{n+1} = u_n + w / b`, the step's end from the increment `w` of the blend.
+    fn step_end(&self, form: &StepForm, w: &[Real]) -> Vec<Real> {
+        let du: Vec<Real> = w.iter().map(|w| w / form.blend).collect();
+        advanced(&self.motion, &du)
+    }
+
     /// Refill the tangent `K_T(y) + β c_v K + (c + α c_v) M` and factor it, unless a linear
     /// body keeps its factor for this step size.
     fn refactor(
         &mut self,
         body: &Body,
         form: &StepForm,
-        y: &[Real],
+        w: &[Real],
         h: Real,
         name: &'static str,
     ) -> Result<(), String> {
@@ -250,12 +251,9 @@ impl BodyMotion {
         }
         let t = Instant::now();
         let start = self.motion.u.clone();
-        let b = form.blend;
-        let u1: Vec<Real> = y
-            .iter()
-            .zip(&start)
-            .map(|(y, u)| (y - (1.0 - b) * u) / b)
-            .collect();
+        let y = advanced(&self.motion, w);
+        let y = &y;
+        let u1 = self.step_end(form, w);
         let beta_c = self.damping.stiffness * form.velocity_coefficient;
         let dg = form.discrete_gradient;
         self.assembly.fill(
@@ -330,25 +328,18 @@ impl BodyMotion {
         let b = form.blend;
         let start = self.motion.u.clone();
         let t1 = t0 + h;
-        let blend = |x0: &[Real], x1: &[Real]| -> Vec<Real> {
-            x0.iter()
-                .zip(x1)
-                .map(|(a, c)| (1.0 - b) * a + b * c)
-                .collect()
-        };
-        let applied = blend(
-            &loads_at_time(body, t0, duration),
-            &loads_at_time(body, t1, duration),
-        );
-        let prescribed = prescribed_at_time(body, t1, duration);
-        // Start from the motion continued at its velocity; the supports at their place.
-        let mut y: Vec<Real> = start
+        let applied: Vec<Real> = loads_at_time(body, t0, duration)
             .iter()
-            .zip(&self.motion.v)
-            .map(|(u, v)| u + b * h * v)
+            .zip(&loads_at_time(body, t1, duration))
+            .map(|(a, c)| (1.0 - b) * a + b * c)
             .collect();
+        let prescribed = prescribed_at_time(body, t1, duration);
+        // Newton carries the increment w = y − u_n of the configuration, not y: the momenta
+        // are then exact sums of the solved increments (see the module README). Start from
+        // the motion continued at its velocity; the supports at their place.
+        let mut w: Vec<Real> = self.motion.v.iter().map(|v| b * h * v).collect();
         for &dof in &self.dofs.supported {
-            y[dof] = (1.0 - b) * start[dof] + b * prescribed[dof];
+            w[dof] = b * (prescribed[dof] - start[dof]);
         }
         // The inertia force of the predicted motion: the scale of a body that only coasts.
         let coasting = norm(
@@ -356,9 +347,7 @@ impl BodyMotion {
                 .dofs
                 .free
                 .iter()
-                .map(|&i| {
-                    form.inertia.coefficient * self.mass[i] * (form.inertia.predictor[i] - start[i])
-                })
+                .map(|&i| form.inertia.coefficient * self.mass[i] * form.predictor_increment[i])
                 .collect::<Vec<_>>(),
         );
         let mut convergence = Convergence::new(body.newton.tolerance);
@@ -369,7 +358,7 @@ impl BodyMotion {
         let mut iterations = 0;
         let forces = loop {
             let t = Instant::now();
-            let f = self.forces(body, &form, &y, &applied);
+            let f = self.forces(body, &form, &w, &applied);
             self.times.assembly += t.elapsed().as_secs_f64();
             let free_norm =
                 |v: &[Real]| norm(&self.dofs.free.iter().map(|&i| v[i]).collect::<Vec<_>>());
@@ -411,7 +400,7 @@ impl BodyMotion {
                     &convergence,
                 ));
             }
-            self.refactor(body, &form, &y, h, integrator.name())
+            self.refactor(body, &form, &w, h, integrator.name())
                 .map_err(|reason| fail(reason, &convergence))?;
             let mut delta = r;
             let t = Instant::now();
@@ -422,15 +411,11 @@ impl BodyMotion {
             self.times.solve += t.elapsed().as_secs_f64();
             solved.map_err(|e| fail(self.describe(e), &convergence))?;
             for (i, &dof) in self.dofs.free.iter().enumerate() {
-                y[dof] += delta[i];
+                w[dof] += delta[i];
             }
             iterations += 1;
         };
-        let u1: Vec<Real> = y
-            .iter()
-            .zip(&start)
-            .map(|(y, u)| (y - (1.0 - b) * u) / b)
-            .collect();
+        let du: Vec<Real> = w.iter().map(|w| w / b).collect();
         let mut report = TimeStepReport {
             iterations,
             residual_history: convergence.history,
@@ -438,8 +423,7 @@ impl BodyMotion {
         };
         let supported =
             |i: usize| matches!(self.dofs.slots[i], crate::linkage::DofSlot::Supported(_));
-        for i in 0..u1.len() {
-            let du = u1[i] - start[i];
+        for (i, &du) in du.iter().enumerate() {
             let reaction = if supported(i) {
                 forces.internal[i] + forces.damping[i] + forces.inertia[i] - forces.applied[i]
             } else {
@@ -448,7 +432,7 @@ impl BodyMotion {
             report.external_work += (forces.applied[i] + reaction) * du;
             report.dissipated += forces.damping[i] * du;
         }
-        self.motion = integrator.finish(&self.motion, u1, h);
+        self.motion = integrator.finish(&self.motion, du, h);
         Ok(report)
     }
 

@@ -1,6 +1,7 @@
 //! The energy–momentum method (Simo & Tarnow 1992; Gonzalez 2000): the midpoint rule with the
 //! member forces of the discrete gradient of their energy.
 
+use crate::linkage::dynamics::integrator::advanced;
 use crate::linkage::dynamics::{InertiaTerm, Integrator, Motion, StepForm};
 use crate::Real;
 
@@ -19,32 +20,32 @@ impl Integrator for EnergyMomentum {
     }
 
     fn form(&self, start: &Motion, mass: &[Real], h: Real) -> StepForm {
+        let predictor_increment: Vec<Real> = start.v.iter().map(|v| 0.5 * h * v).collect();
         StepForm {
             blend: 0.5,
             inertia: InertiaTerm {
                 mass: mass.to_vec(),
                 coefficient: 4.0 / (h * h),
-                predictor: start
-                    .u
-                    .iter()
-                    .zip(&start.v)
-                    .map(|(u, v)| u + 0.5 * h * v)
-                    .collect(),
+                predictor: advanced(start, &predictor_increment),
             },
+            predictor_increment,
             velocity_coefficient: 2.0 / h,
-            velocity_predictor: start.u.clone(),
+            velocity_predictor: vec![0.0; start.u.len()],
             discrete_gradient: true,
         }
     }
 
-    fn finish(&self, start: &Motion, u: Vec<Real>, h: Real) -> Motion {
-        let v: Vec<Real> = u
+    fn finish(&self, start: &Motion, du: Vec<Real>, h: Real) -> Motion {
+        let v: Vec<Real> = du
             .iter()
-            .zip(&start.u)
             .zip(&start.v)
-            .map(|((u1, u0), v0)| 2.0 * (u1 - u0) / h - v0)
+            .map(|(d, v0)| 2.0 * d / h - v0)
             .collect();
         let a = v.iter().zip(&start.v).map(|(a, b)| (a - b) / h).collect();
-        Motion { u, v, a }
+        Motion {
+            u: advanced(start, &du),
+            v,
+            a,
+        }
     }
 }

@@ -40,9 +40,9 @@ impl Integrator for GeneralizedAlpha {
         alpha_form(start, mass, h, self.newmark_parameters(), self.alphas())
     }
 
-    fn finish(&self, start: &Motion, u: Vec<Real>, h: Real) -> Motion {
+    fn finish(&self, start: &Motion, du: Vec<Real>, h: Real) -> Motion {
         let (beta, gamma) = self.newmark_parameters();
-        newmark_finish(start, u, h, beta, gamma)
+        newmark_finish(start, du, h, beta, gamma)
     }
 
     fn needs_initial_acceleration(&self) -> bool {

@@ -23,7 +23,7 @@ pub struct Motion {
 ///
 /// `f_int(y) + C v_eval(y) + inertia.coefficient · M (y − inertia.predictor) = F(t_n + b h)`
 ///
-/// with `v_eval = velocity_coefficient · (y − velocity_predictor)` the velocity the damping
+/// with `v_eval = velocity_coefficient · (y − u_n − velocity_predictor)` the velocity the damping
 /// sees, and `f_int` the member forces at `y` or, for the energy–momentum method, their discrete
 /// gradient between `u_n` and `u_{n+1}`.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,9 +33,14 @@ pub struct StepForm {
     pub blend: Real,
     /// The inertia term in `y`.
     pub inertia: InertiaTerm,
+    /// `inertia.predictor − u_n` per body DOF (m), formed from the velocities and
+    /// accelerations without `u_n`: the solvers carry the increment `y − u_n`, so the inertia
+    /// force `c M ((y − u_n) − (y* − u_n))` has no round-off of the size of `|u_n|` (which
+    /// would drift the momenta of a body far from its start).
+    pub predictor_increment: Vec<Real>,
     /// Factor of `y` in the velocity the damping sees, 1/s.
     pub velocity_coefficient: Real,
-    /// The configuration at which that velocity vanishes, per body DOF, m.
+    /// The configuration at which that velocity vanishes, less `u_n`, per body DOF, m.
     pub velocity_predictor: Vec<Real>,
     /// Whether member forces are the discrete gradient of their energy between the step's two
     /// ends (energy–momentum) rather than the forces at `y`.
@@ -49,9 +54,10 @@ pub trait Integrator {
     fn name(&self) -> &'static str;
     /// The form of the step of `h` (s) from `start`, with lumped `mass` per body DOF (kg).
     fn form(&self, start: &Motion, mass: &[Real], h: Real) -> StepForm;
-    /// Velocities and accelerations at the step's end, from `start` and the solved
-    /// displacements `u` at its end.
-    fn finish(&self, start: &Motion, u: Vec<Real>, h: Real) -> Motion;
+    /// Displacements, velocities and accelerations at the step's end, from `start` and the
+    /// solved increment `du = u_{n+1} − u_n` (per body DOF, m). Velocities come from `du`
+    /// itself, never from `u_{n+1} − u_n` re-formed from absolute displacements.
+    fn finish(&self, start: &Motion, du: Vec<Real>, h: Real) -> Motion;
     /// Whether the acceleration carried from step to step must start balanced,
     /// `a₀ = M⁻¹(F(0) − f_int(u₀) − C v₀)` (Newmark and generalized-α).
     fn needs_initial_acceleration(&self) -> bool {
@@ -64,24 +70,34 @@ pub(crate) fn axpy(a: &[Real], s: Real, b: &[Real]) -> Vec<Real> {
     a.iter().zip(b).map(|(x, y)| x + s * y).collect()
 }
 
-/// The Newmark predictor `u_n + h v_n + h² (½ − β) a_n` (the displacement at which
-/// `a_{n+1} = 0`), per body DOF, m.
-pub(crate) fn newmark_predictor(start: &Motion, h: Real, beta: Real) -> Vec<Real> {
-    let with_v = axpy(&start.u, h, &start.v);
-    axpy(&with_v, h * h * (0.5 - beta), &start.a)
+/// The increment of the Newmark predictor, `h v_n + h² (½ − β) a_n` (`ũ − u_n`, the
+/// displacement at which `a_{n+1} = 0`, less `u_n`), per body DOF, m.
+pub(crate) fn newmark_predictor_increment(start: &Motion, h: Real, beta: Real) -> Vec<Real> {
+    start
+        .v
+        .iter()
+        .zip(&start.a)
+        .map(|(v, a)| h * v + h * h * (0.5 - beta) * a)
+        .collect()
 }
 
-/// The step's end of a Newmark (β, γ) family member: `a_{n+1} = (u_{n+1} − ũ)/(β h²)` with
-/// `ũ` the [`newmark_predictor`], `v_{n+1} = v_n + h((1 − γ) a_n + γ a_{n+1})`.
+/// `u_n + du`, the displacements at the step's end, per body DOF, m.
+pub(crate) fn advanced(start: &Motion, du: &[Real]) -> Vec<Real> {
+    start.u.iter().zip(du).map(|(u, d)| u + d).collect()
+}
+
+/// The step's end of a Newmark (β, γ) family member from the increment `du`:
+/// `a_{n+1} = (du − (ũ − u_n))/(β h²)` with `ũ` the Newmark predictor,
+/// `v_{n+1} = v_n + h((1 − γ) a_n + γ a_{n+1})`.
 pub(crate) fn newmark_finish(
     start: &Motion,
-    u: Vec<Real>,
+    du: Vec<Real>,
     h: Real,
     beta: Real,
     gamma: Real,
 ) -> Motion {
-    let p = newmark_predictor(start, h, beta);
-    let a: Vec<Real> = u
+    let p = newmark_predictor_increment(start, h, beta);
+    let a: Vec<Real> = du
         .iter()
         .zip(&p)
         .map(|(x, q)| (x - q) / (beta * h * h))
@@ -93,7 +109,11 @@ pub(crate) fn newmark_finish(
         .zip(&a)
         .map(|((v, a0), a1)| v + h * ((1.0 - gamma) * a0 + gamma * a1))
         .collect();
-    Motion { u, v, a }
+    Motion {
+        u: advanced(start, &du),
+        v,
+        a,
+    }
 }
 
 /// The form of a step of the generalized-α family (Newmark is `α_m = α_f = 0`): forces at
@@ -107,16 +127,11 @@ pub(crate) fn alpha_form(
     (alpha_m, alpha_f): (Real, Real),
 ) -> StepForm {
     let b = 1.0 - alpha_f;
-    let p = newmark_predictor(start, h, beta);
-    // The configuration y where a_{n+1} = 0: (1 − b) u_n + b ũ.
-    let y0: Vec<Real> = start
-        .u
-        .iter()
-        .zip(&p)
-        .map(|(un, q)| (1.0 - b) * un + b * q)
-        .collect();
+    let p = newmark_predictor_increment(start, h, beta);
+    // The configuration y where a_{n+1} = 0, less u_n: b (ũ − u_n).
+    let y0: Vec<Real> = p.iter().map(|q| b * q).collect();
     let coefficient = (1.0 - alpha_m) / (b * beta * h * h);
-    let predictor = axpy(&y0, -alpha_m * b * beta * h * h / (1.0 - alpha_m), &start.a);
+    let predictor_increment = axpy(&y0, -alpha_m * b * beta * h * h / (1.0 - alpha_m), &start.a);
     let velocity_coefficient = gamma / (beta * h);
     let velocity_predictor = y0
         .iter()
@@ -129,8 +144,9 @@ pub(crate) fn alpha_form(
         inertia: InertiaTerm {
             mass: mass.to_vec(),
             coefficient,
-            predictor,
+            predictor: advanced(start, &predictor_increment),
         },
+        predictor_increment,
         velocity_coefficient,
         velocity_predictor,
         discrete_gradient: false,

@@ -33,8 +33,8 @@ impl Integrator for Newmark {
         alpha_form(start, mass, h, (self.beta, self.gamma), (0.0, 0.0))
     }
 
-    fn finish(&self, start: &Motion, u: Vec<Real>, h: Real) -> Motion {
-        newmark_finish(start, u, h, self.beta, self.gamma)
+    fn finish(&self, start: &Motion, du: Vec<Real>, h: Real) -> Motion {
+        newmark_finish(start, du, h, self.beta, self.gamma)
     }
 
     fn needs_initial_acceleration(&self) -> bool {
