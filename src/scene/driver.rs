@@ -259,6 +259,7 @@ fn solve_steps(
                 member: r.member,
                 load_factor: r.load_factor,
                 tooth: r.tooth,
+                time: r.time,
             }));
         }
         if step == 0 {

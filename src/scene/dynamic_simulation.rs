@@ -5,10 +5,13 @@ use crate::linkage::dynamics::{
     angular_momentum, kinetic_energy, momentum, strain_energy, time_factor, BodyMotion, Integrator,
     TimeStepFailure, TimeStepReport,
 };
+use crate::linkage::fracture::breaks_members;
 use crate::linkage::{Body, PhaseTimes, SolveError};
+use crate::scene::dynamic_fracture::BreakingBodies;
 use crate::scene::dynamics_settings::DynamicsSettings;
 use crate::scene::results::{
-    BodyMomentum, BodyResult, BodySize, StepEnergy, StepResult, StepSummary,
+    BodyFracture, BodyMomentum, BodyResult, BodySize, BreakRecord, StepEnergy, StepResult,
+    StepSummary,
 };
 use crate::scene::run_error::RunError;
 use crate::scene::simulation::empty_summary;
@@ -66,6 +69,8 @@ pub struct DynamicSimulation<'w> {
     /// Work of the applied forces and supports, and damping's dissipation, since t = 0, J.
     external_work: Real,
     dissipated: Real,
+    /// The bodies' breaking members, when some break (their own copies of the bodies).
+    fracture: Option<BreakingBodies>,
 }
 
 impl<'w> DynamicSimulation<'w> {
@@ -88,6 +93,10 @@ impl<'w> DynamicSimulation<'w> {
             });
         };
         let integrator = settings.integrator.integrator();
+        let fracture = BreakingBodies::new(&world.bodies).map_err(|source| RunError::Solve {
+            scene: world.source.clone(),
+            source,
+        })?;
         let mut motions = Vec::with_capacity(world.bodies.len());
         for (body, start) in world.bodies.iter().zip(&settings.bodies) {
             let mut m = BodyMotion::new(
@@ -116,6 +125,7 @@ impl<'w> DynamicSimulation<'w> {
             streak: 0,
             external_work: 0.0,
             dissipated: 0.0,
+            fracture,
         })
     }
 
@@ -148,12 +158,22 @@ impl<'w> DynamicSimulation<'w> {
                 let ticks = (TICKS >> self.depth).min(total - pos);
                 let h = full * (ticks as Real / TICKS as Real);
                 let t0 = start + full * (pos as Real / TICKS as Real);
-                match solve_time_step(
-                    &mut self.motions,
-                    &world.bodies,
-                    self.integrator.as_ref(),
-                    (t0, h, duration),
-                ) {
+                let integrator = self.integrator.as_ref();
+                let solved = match self.fracture.as_mut() {
+                    Some(f) => f.solve_step(
+                        &mut self.motions,
+                        &mut |m, b, t, h| solve_time_step(m, b, integrator, (t, h, duration)),
+                        (t0, h, duration),
+                        integrator.needs_initial_acceleration(),
+                    ),
+                    None => solve_time_step(
+                        &mut self.motions,
+                        &world.bodies,
+                        integrator,
+                        (t0, h, duration),
+                    ),
+                };
+                match solved {
                     Ok(reports) => {
                         pos += ticks;
                         time_steps += 1;
@@ -217,7 +237,12 @@ impl<'w> DynamicSimulation<'w> {
             smallest_time_step: if time_steps > 0 { smallest } else { 0.0 },
             ..Default::default()
         };
-        for (body, m) in world.bodies.iter().zip(&self.motions) {
+        let breaks = self.fracture.as_mut().map(|f| f.take_breaks());
+        let bodies = self
+            .fracture
+            .as_ref()
+            .map_or(&world.bodies[..], |f| &f.bodies[..]);
+        for (k, (body, m)) in bodies.iter().zip(&self.motions).enumerate() {
             let state = m.state(body, t, duration);
             summary.overloaded += state.overloaded.len();
             summary.max_displacement = state
@@ -228,6 +253,23 @@ impl<'w> DynamicSimulation<'w> {
             let mut written = BodyResult::new(body, &state);
             let d = body.dimension.dofs_per_node();
             written.velocities = m.motion.v.chunks(d).map(|c| c.to_vec()).collect();
+            if let (Some(f), Some(breaks)) = (&self.fracture, &breaks) {
+                if breaks_members(body) {
+                    written.fracture = Some(BodyFracture {
+                        broken: f.broken[k].iter().map(|j| j + 1).collect(),
+                        breaks: breaks[k]
+                            .iter()
+                            .map(|b| BreakRecord {
+                                member: b.member + 1,
+                                load_factor: time_load_factor(world, b.time, duration),
+                                tooth: None,
+                                time: Some(b.time),
+                            })
+                            .collect(),
+                        fallen: Vec::new(),
+                    });
+                }
+            }
             if let Some(quantity) = written
                 .non_finite()
                 .or_else(|| (!m.motion.v.iter().all(|v| v.is_finite())).then_some("velocities"))

@@ -102,6 +102,14 @@ pub(crate) fn step_npz(step: &StepResult, dimensions: &[usize]) -> std::io::Resu
                     breaks.iter().map(|b| b.tooth.unwrap_or(0)),
                 )?;
             }
+            // Written only for breaks in time (a dynamic scene).
+            if breaks.iter().any(|b| b.time.is_some()) {
+                out.f64s(
+                    &key("breaks_time"),
+                    &[breaks.len()],
+                    breaks.iter().map(|b| b.time.as_ref().unwrap_or(&0.0)),
+                )?;
+            }
             out.i64s(&key("fallen"), &[f.fallen.len()], f.fallen.iter().copied())?;
         }
         out.f64s(

@@ -85,6 +85,9 @@ pub struct BreakRecord {
     /// material's `softening.teeth`); absent for a break.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tooth: Option<usize>,
+    /// The time at which it broke, s (a dynamic scene; absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time: Option<Real>,
 }
 
 /// The fracture fields of a body at one step.
@@ -116,6 +119,9 @@ pub struct SummaryBreak {
     /// break.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tooth: Option<usize>,
+    /// The time at which it broke, s (a dynamic scene; absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time: Option<Real>,
 }
 
 /// The collapse of a structure: a break left its supported part a mechanism.

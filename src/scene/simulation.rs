@@ -443,6 +443,7 @@ impl<'w> Simulation<'w> {
                     member: r.member,
                     load_factor: r.load_factor,
                     tooth: r.tooth,
+                    time: None,
                 })
                 .collect(),
         }
@@ -461,6 +462,7 @@ impl<'w> Simulation<'w> {
                 member: b.member + 1,
                 load_factor: from + b.fraction * (to - from),
                 tooth: b.tooth,
+                time: None,
             })
             .collect()
     }

@@ -138,6 +138,12 @@ impl BodyMotion {
         })
     }
 
+    /// Forget the kept factorization of a linear body: its members changed (one broke), so
+    /// the next step refactors even at the same step size.
+    pub fn forget_factor(&mut self) {
+        self.kept = None;
+    }
+
     /// Which linear solver the step's tangent gets: direct or iterative.
     pub fn solver_used(&self) -> SolverUsed {
         if self.solver.as_ref().is_some_and(|s| s.is_iterative()) {
@@ -151,7 +157,14 @@ impl BodyMotion {
     /// at the free DOFs (0 at the supported ones), into the motion: Newmark and generalized-α
     /// start from it, so that a load applied in full at t = 0 acts from the first step.
     pub fn balance_initial_acceleration(&mut self, body: &Body, duration: Real) {
-        let forces = loads_at_time(body, 0.0, duration);
+        self.balance_acceleration(body, 0.0, duration);
+    }
+
+    /// [`BodyMotion::balance_initial_acceleration`] at time `t` (s) of `duration`, from the
+    /// current displacement and velocity: after a member breaks at `t` the acceleration jumps
+    /// (its force is gone), and Newmark and generalized-α continue from the balanced one.
+    pub fn balance_acceleration(&mut self, body: &Body, t: Real, duration: Real) {
+        let forces = loads_at_time(body, t, duration);
         let mut internal = vec![0.0; forces.len()];
         internal_forces(body, &self.motion.u, &mut internal);
         let mut damping = vec![0.0; forces.len()];
