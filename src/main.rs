@@ -721,7 +721,9 @@ fn print_check(path: &Path, report: &linkage::scene::CheckReport) {
 }
 
 fn prepare(input: &Path, spacing: f64, out: &Path) -> Result<()> {
-    let body = linkage::scene::prepare_file(input, spacing).map_err(anyhow::Error::msg)?;
+    catch_signals();
+    let body = linkage::scene::prepare_file(input, spacing, Interrupt::on(&STOP))
+        .map_err(anyhow::Error::msg)?;
     create_out_folder(out)?;
     let stem = input
         .file_stem()
@@ -869,7 +871,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         } else {
             VtkEncoding::Binary
         };
-        let files = write_vtk(&run, &out, encoding)?;
+        let files = write_vtk(&run, &out, encoding, Interrupt::on(&STOP))?;
         say!(
             "wrote {} ParaView files in {}",
             files.len(),

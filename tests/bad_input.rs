@@ -368,7 +368,8 @@ fn generator_keys_of_another_generator_are_errors() {
     ] {
         let text = format!("name = \"t\"\n{MATERIAL}\n[[bodies]]\nname = \"g\"\n{generator}\n");
         let msg = scene_error(&c, &text);
-        assert_has(&msg, &["scene.toml", "line 9", &format!("unknown field `{foreign}`"), "expected"]);
+        let name = generator.split(' ').next().unwrap();
+        assert_has(&msg, &["scene.toml", "line 9", &format!("{name}: unknown key `{foreign}`"), "expected"]);
     }
 }
 
@@ -908,4 +909,169 @@ fn a_body_check_made_before_solving_points_at_the_key_not_the_body_header() {
     c.file("s.nodes", "1 1\n0 1\n0 0\n1 0\n2 2\n");
     let e = c.error(SUPPORTS);
     assert_has(&e, &["scene.toml:10:", "node 5"]);
+}
+
+/// Issue 33, item 7: an unknown key inside a generator names the generator (inline tables and
+/// `[bodies.<generator>]` tables), the line and column, and the keys it takes.
+#[test]
+fn generator_key_errors_name_the_generator() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "box_lattice = { size = [1.0, 1.0, 1.0], cell = [3, 3, 3] }",
+            "box_lattice: unknown key `cell`, expected",
+            "`cells`",
+        ),
+        (
+            "rectangle = { width = 1.0, height = 0.1, cell = [10, 1] }",
+            "rectangle: unknown key `cell`, expected",
+            "`cells`",
+        ),
+        (
+            "disk = { radius = 1.0, ring = 3 }",
+            "disk: unknown key `ring`, expected",
+            "`rings`",
+        ),
+        (
+            "[bodies.cylindrical_shell]\nradius = 1.0\nlenght = 2.0",
+            "cylindrical_shell: unknown key `lenght`, expected",
+            "`length`",
+        ),
+    ];
+    for (body, named, valid) in cases {
+        let line = if body.starts_with('[') {
+            "line 11"
+        } else {
+            "line 9"
+        };
+        let text = format!("name = \"t\"\n{MATERIAL}\n[[bodies]]\nname = \"b\"\n{body}\n");
+        let path = dir.path().join("gen.toml");
+        std::fs::write(&path, &text).unwrap();
+        let message = load_scene(&path).unwrap_err().to_string();
+        assert_has(&message, &["gen.toml", line, named, valid]);
+    }
+    // A key outside a generator is not given one.
+    let text = format!("name = \"t\"\n{MATERIAL}\n[[bodies]]\nname = \"b\"\nnodez = \"s.nodes\"\n");
+    let path = dir.path().join("gen.toml");
+    std::fs::write(&path, &text).unwrap();
+    let message = load_scene(&path).unwrap_err().to_string();
+    assert!(!message.contains(": unknown key"), "{message}");
+}
+
+/// Issue 33, item 4: absurd sizes besides `steps` are refused with a message before anything is
+/// allocated or written: `[dynamics]` frames and time steps, a mesh spacing of 1e-9 m, and a
+/// sweep grid of 10¹² variants (four keys of 1,000 values; `sweep.rs` holds the 10⁶ × 10⁶ grid).
+#[test]
+fn absurd_frames_spacings_and_sweeps_are_refused_before_allocating() {
+    let case = Case::new();
+    let run = |name: &str, text: &str| {
+        let scene = case.dir.path().join(name);
+        std::fs::write(&scene, text).unwrap();
+        let out = case.dir.path().join("out");
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_linkage"))
+            .arg("run")
+            .arg(&scene)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let said = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert_ne!(o.status.code(), Some(0), "{name}: {said}");
+        assert!(o.status.code().is_some(), "{name}: killed: {said}");
+        // Only the failed row of batch.csv.
+        let left: Vec<String> = std::fs::read_dir(&out)
+            .map(|r| {
+                r.flatten()
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        assert!(
+            left.iter().all(|n| n == "batch.csv"),
+            "{name} wrote {left:?}: {said}"
+        );
+        said
+    };
+    let dynamics = |settings: &str| {
+        format!("name = \"t\"\n[dynamics]\n{settings}\n[[materials]]\nname = \"rubber\"\nyoungs_modulus = 1e7\narea = 1e-3\ndensity = 1000.0\n[[bodies]]\nname = \"c\"\nrectangle = {{ width = 1.0, height = 0.1, cells = [10, 1] }}\n[[bodies.supports]]\nnodes = [1]\nfix = [\"x\", \"y\"]\n")
+    };
+    let said = run(
+        "frames.toml",
+        &dynamics("duration = 1.5\ntime_step = 1.5e-9\nframes = 1000000000"),
+    );
+    assert_has(
+        &said,
+        &["frames.toml", "GB of memory", "available", "fewer frames"],
+    );
+    let said = run(
+        "time_step.toml",
+        &dynamics("duration = 1.5\ntime_step = 1e-15\nframes = 10"),
+    );
+    assert_has(
+        &said,
+        &[
+            "time_step.toml:4",
+            "`time_step`",
+            "steps",
+            "longer time step",
+        ],
+    );
+    let said = run(
+        "more_frames.toml",
+        &dynamics("duration = 1.5\ntime_step = 0.005\nframes = 4000000000"),
+    );
+    assert_has(
+        &said,
+        &["more_frames.toml:5", "`frames`", "at most 300 frames"],
+    );
+    std::fs::write(
+        case.dir.path().join("cube.obj"),
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n",
+    )
+    .unwrap();
+    let said = run(
+        "spacing.toml",
+        &format!("name = \"t\"\n{MATERIAL}\n[[bodies]]\nname = \"cube\"\nmesh = {{ file = \"cube.obj\", spacing = 1e-9 }}\n[[bodies.supports]]\nnodes = [1]\nfix = [\"x\", \"y\", \"z\"]\n"),
+    );
+    // (1 m / 1e-9 m)³ cells: about 1.4e28 members, 5.1e21 GB while preparing.
+    assert_has(
+        &said,
+        &[
+            "spacing.toml:9",
+            "body 'cube'",
+            "spacing = 0.000000001 m",
+            "e28 members",
+            "e21 GB while preparing",
+            "give a spacing of at least",
+        ],
+    );
+    let values = |first: f64, step: f64| {
+        (0..1000)
+            .map(|k| format!("{:?}", first + step * k as f64))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let sweep = format!(
+        "name = \"t\"\n{MATERIAL}\n[[bodies]]\nname = \"sq\"\nnodes = \"s.nodes\"\nlinks = \"s.links\"\n[[bodies.supports]]\nnodes = [3]\nfix = [\"x\", \"y\"]\n[[bodies.loads]]\nnodes = [2]\nforce = [200.0, 0.0]\n[sweep]\n\"materials.1.youngs_modulus\" = [{}]\n\"materials.1.area\" = [{}]\n\"bodies.1.loads.1.force.1\" = [{}]\n\"bodies.1.loads.1.force.2\" = [{}]\n",
+        values(1e9, 1e6),
+        values(1e-4, 1e-8),
+        values(1.0, 1.0),
+        values(-1.0, -1.0)
+    );
+    let said = run("sweep.toml", &sweep);
+    assert_has(
+        &said,
+        &[
+            "sweep.toml:17",
+            "[sweep] makes 1000000000000 variants",
+            "1000 × 1000 × 1000 × 1000",
+            "GB of memory",
+            "GB of disk",
+            "at most 1000000 variants",
+        ],
+    );
 }

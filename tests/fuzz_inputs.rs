@@ -1,18 +1,23 @@
 //! Fuzzing the inputs: the bundled scenes (`scenes/*.toml`) and their node and link files,
 //! mutated (lines deleted, duplicated, swapped; numbers replaced by extreme values; keys
 //! swapped; values changed to another type; arrays emptied; files truncated), loaded and run.
-//! A case fails on a panic, a hang, a non-finite number in an output file, or an output
-//! folder that a failed run may not leave (README, *Output*).
+//! Besides the bundled scenes, two scenes read a model file (`tests/models/space_truss.inp`,
+//! `tests/models/plate_hole.msh`), mutated as the node and link files are. One case in eight
+//! raises the run's interrupt (what SIGINT and SIGTERM do) at a random moment.
+//! A case fails on a panic, a hang (more than [`TIMEOUT`] of the process's CPU time: on a loaded
+//! machine wall time says nothing), a non-finite number in an output file, or an output
+//! folder that a failed or interrupted run may not leave (README, *Output*).
 //!
 //! `LINKAGE_FUZZ_CASES` sets the number of cases (default [`DEFAULT_CASES`]) and
 //! `LINKAGE_FUZZ_SEED` the seed (default fixed, so CI is deterministic).
 
+use linkage::linkage::Interrupt;
 use linkage::scene::{batch, build_world, load_scene, run, RunError, World};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
@@ -20,13 +25,19 @@ use std::time::{Duration, Instant};
 const DEFAULT_CASES: u32 = 250;
 /// The default seed.
 const DEFAULT_SEED: u64 = 0x6c69_6e6b_6167_6531;
-/// A case that takes longer than this hangs.
+/// A case that takes more than this CPU time of the process hangs.
 const TIMEOUT: Duration = Duration::from_secs(20);
+/// A case that takes more than this wall time hangs even without CPU time (a deadlock).
+const WALL_TIMEOUT: Duration = Duration::from_secs(600);
+/// How long a case raised for a hang is given to stop.
+const STOP_GRACE: Duration = Duration::from_secs(20);
 /// Load steps of a case: the scene's own, but at most this many.
 const STEPS: usize = 3;
 /// Models larger than these after mutation are not run (too slow for a fuzz case).
 const MAX_MEMBERS: usize = 50_000;
 const MAX_STEPS: usize = 10;
+/// A dynamic scene of more time steps than this is not run (the bundled one has 300).
+const MAX_TIME_STEPS: usize = 1000;
 
 /// Values a number is replaced with.
 const EXTREMES: &[&str] = &[
@@ -131,7 +142,32 @@ const FEATURES: &[(Place, &str)] = &[
     (Place::End, "[sweep]\n\"materials.1.youngs_modulus\" = [1e9, 2e11]"),
     (Place::End, "[sweep]\nmode = \"zip\"\n\"materials.1.area\" = [1e-4, 2e-4]\n\"steps\" = [1, 2]"),
     (Place::End, "[sweep]\n\"bodies.1.supports.1.fix\" = [[\"x\"], [\"x\", \"y\"]]"),
+    (Place::End, "[dynamics]\nduration = 0.02\ntime_step = 0.01\nframes = 2\nintegrator = \"energy_momentum\""),
+    (Place::End, "[dynamics]\nduration = 0.03\ntime_step = 0.01\nframes = 3\nintegrator = \"newmark\"\ndamping = { mass = 1.0, stiffness = 1e-4 }"),
+    (Place::Body, "velocity = [0.0, -2.0]\nangular_velocity = 5.0"),
+    (Place::End, "[[bodies.velocities]]\nnodes = [1]\nvelocity = [1.0, 0.0, 0.0]"),
+    (Place::End, "[[bodies]]\nname = \"fuzz_inp\"\nmodel = \"space_truss.inp\"\noffset = [0.0, 0.0, 5.0]"),
+    (Place::End, "[[bodies]]\nname = \"fuzz_msh\"\nmodel = \"plate_hole.msh\"\noffset = [0.0, 5.0]\n[[bodies.supports]]\ngroup = \"clamp\"\nfix = [\"x\", \"y\"]\n[[bodies.loads]]\ngroup = \"tip\"\ntotal_force = [100.0, 0.0]"),
 ];
+
+/// Scenes besides the bundled ones: bodies read from the model files of `tests/models`.
+const MODEL_SCENES: &[(&str, &str)] = &[
+    (
+        "fuzz_inp.toml",
+        "name = \"fuzz_inp\"\nsteps = 2\n\n[[bodies]]\nname = \"truss\"\nmodel = \"space_truss.inp\"\n",
+    ),
+    (
+        "fuzz_msh.toml",
+        "name = \"fuzz_msh\"\nsteps = 2\n\n[[materials]]\nname = \"aluminium\"\nyoungs_modulus = 70e9\narea = 1e-6\n\n[[bodies]]\nname = \"plate\"\nmodel = \"plate_hole.msh\"\nmaterial = \"aluminium\"\n\n[[bodies.supports]]\ngroup = \"clamp\"\nfix = [\"x\", \"y\"]\n\n[[bodies.loads]]\ngroup = \"tip\"\ntotal_force = [100.0, 0.0]\n",
+    ),
+];
+
+/// The model files of `tests/models` the scenes and features name.
+const MODEL_FILES: &[&str] = &["space_truss.inp", "plate_hole.msh"];
+
+fn models_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/models")
+}
 
 /// The first `name = "..."` after a line starting with `header`.
 fn first_name_after(text: &str, header: &str) -> Option<String> {
@@ -222,8 +258,30 @@ fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
 }
 
-/// The bundled scenes, their steps capped at [`STEPS`] (schedules cut to match).
+/// The bundled scenes and [`MODEL_SCENES`], their steps capped at [`STEPS`] (schedules cut to
+/// match).
 fn bundled_scenes() -> Vec<Scene> {
+    let mut scenes = scenes_of_the_folder();
+    for (file, text) in MODEL_SCENES {
+        let files = MODEL_FILES
+            .iter()
+            .filter(|m| text.contains(&format!("\"{m}\"")))
+            .map(|m| {
+                let text = std::fs::read_to_string(models_dir().join(m)).unwrap();
+                (m.to_string(), text)
+            })
+            .collect();
+        scenes.push(Scene {
+            file: file.to_string(),
+            text: cap_steps(text),
+            files,
+        });
+    }
+    scenes
+}
+
+/// The bundled scenes (`scenes/*.toml`) with the node, link, mesh and outline files they name.
+fn scenes_of_the_folder() -> Vec<Scene> {
     let dir = scenes_dir();
     let mut names: Vec<String> = std::fs::read_dir(&dir)
         .unwrap()
@@ -444,11 +502,13 @@ fn apply(text: &str, edit: &Edit) -> String {
     join(&lines)
 }
 
-/// A case: one bundled scene and the mutations applied to it.
+/// A case: one bundled scene and the mutations applied to it; with `interrupt`, the run's
+/// interrupt raised this many milliseconds after it starts (as a signal would).
 #[derive(Clone, Debug)]
 struct Case {
     scene: usize,
     mutations: Vec<Mutation>,
+    interrupt: Option<u64>,
 }
 
 /// The files of a case: the scene text and its node and link files, mutated.
@@ -476,9 +536,11 @@ fn mutate(scene: &Scene, mutations: &[Mutation]) -> Files {
         .zip(&texts[1..])
         .map(|((name, _), t)| (name.clone(), t.clone()))
         .collect();
-    for name in ["ring.obj", "plate_with_hole.txt"] {
+    let bundled = ["ring.obj", "plate_with_hole.txt"].map(|n| (n, scenes_dir()));
+    let models = MODEL_FILES.iter().map(|n| (*n, models_dir()));
+    for (name, dir) in bundled.into_iter().chain(models) {
         if texts[0].contains(&format!("\"{name}\"")) && !aux.iter().any(|(n, _)| n == name) {
-            let text = std::fs::read_to_string(scenes_dir().join(name)).unwrap();
+            let text = std::fs::read_to_string(dir.join(name)).unwrap();
             aux.push((name.to_string(), text));
         }
     }
@@ -519,6 +581,8 @@ enum Outcome {
     /// A scene with `[sweep]`, its variants run as a batch does: per variant its results
     /// folder and whether every step was solved.
     Swept(Vec<(PathBuf, bool)>),
+    /// Its interrupt was raised and it stopped: nothing written.
+    Interrupted,
 }
 
 /// Variants of a swept case: more are not run (too slow for a fuzz case).
@@ -526,7 +590,7 @@ const MAX_VARIANTS: usize = 4;
 
 /// A scene with `[sweep]` run as `linkage run` runs it: its variants planned, each built and
 /// run into `out/<name>/<k>/`.
-fn run_sweep(path: &Path, out: &Path) -> Outcome {
+fn run_sweep(path: &Path, out: &Path, stop: Interrupt) -> Outcome {
     let Ok(jobs) = batch::plan_jobs(&[path.to_path_buf()]) else {
         return Outcome::Refused;
     };
@@ -554,7 +618,7 @@ fn run_sweep(path: &Path, out: &Path) -> Outcome {
                 None,
                 &|_: &World| {},
                 &|| {},
-                linkage::linkage::Interrupt::default(),
+                stop,
             );
             (job.folder(out), matches!(ran, batch::Ran::Solved { .. }))
         })
@@ -563,7 +627,12 @@ fn run_sweep(path: &Path, out: &Path) -> Outcome {
 }
 
 fn is_too_large(world: &World) -> bool {
+    let time_steps = world
+        .dynamics
+        .as_ref()
+        .map_or(0.0, |d| d.duration / d.time_step);
     world.steps > MAX_STEPS
+        || time_steps > MAX_TIME_STEPS as f64
         || world.bodies.iter().map(|b| b.members.len()).sum::<usize>() > MAX_MEMBERS
         || world.bodies.iter().map(|b| b.nodes.len()).sum::<usize>() > MAX_MEMBERS
 }
@@ -575,7 +644,41 @@ fn known_issue(_files: &Files) -> Option<&'static str> {
 }
 
 /// Counts of outcomes, printed at the end.
-static COUNTS: [AtomicUsize; 8] = [const { AtomicUsize::new(0) }; 8];
+static COUNTS: [AtomicUsize; 9] = [const { AtomicUsize::new(0) }; 9];
+
+/// CPU time of this process so far (user and system, every thread).
+fn process_cpu() -> Duration {
+    // SAFETY: `usage` is a plain struct getrusage fills.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) };
+    let time = |t: libc::timeval| Duration::new(t.tv_sec as u64, t.tv_usec as u32 * 1000);
+    time(usage.ru_utime) + time(usage.ru_stime)
+}
+
+/// The case thread's answer on `receive`, raising `stop` `interrupt` ms after the start; `Err`
+/// saying how long it waited once the case took [`TIMEOUT`] of CPU time or [`WALL_TIMEOUT`].
+fn answer<T>(
+    receive: &mpsc::Receiver<T>,
+    stop: Interrupt,
+    interrupt: Option<u64>,
+) -> Result<T, String> {
+    let (cpu, wall) = (process_cpu(), Instant::now());
+    loop {
+        if let Ok(answer) = receive.recv_timeout(Duration::from_millis(20)) {
+            return Ok(answer);
+        }
+        if interrupt.is_some_and(|ms| wall.elapsed() >= Duration::from_millis(ms)) {
+            stop.raise();
+        }
+        let used = process_cpu().saturating_sub(cpu);
+        if used > TIMEOUT || wall.elapsed() > WALL_TIMEOUT {
+            return Err(format!(
+                "{used:.1?} of CPU time ({:.1?} wall)",
+                wall.elapsed()
+            ));
+        }
+    }
+}
 
 /// Runs `case`; returns its outcome's index in [`COUNTS`].
 fn run_case(scenes: &[Scene], case: &Case) -> Result<usize, TestCaseError> {
@@ -593,20 +696,27 @@ fn run_case(scenes: &[Scene], case: &Case) -> Result<usize, TestCaseError> {
     }
     let out = dir.path().join("out");
     let (send, receive) = mpsc::channel();
+    let stop = Interrupt::on(Box::leak(Box::new(AtomicBool::new(false))));
     {
         let (path, out) = (path.clone(), out.clone());
         std::thread::spawn(move || {
             let swept = std::fs::read_to_string(&path)
                 .is_ok_and(|t| t.lines().any(|l| l.trim_start().starts_with("[sweep]")));
             let outcome = std::panic::catch_unwind(|| match load_scene(&path) {
-                _ if swept => run_sweep(&path, &out),
+                _ if swept => run_sweep(&path, &out, stop),
                 Err(_) => Outcome::Refused,
                 Ok(world) if is_too_large(&world) => Outcome::TooLarge,
-                Ok(world) => match run(&world, &out, &|| {}) {
-                    Ok(_) => Outcome::Ran,
-                    Err(RunError::Stopped { results, .. }) => Outcome::Stopped(results),
-                    Err(e) => Outcome::Failed(e.to_string()),
-                },
+                Ok(mut world) => {
+                    world.set_interrupt(stop);
+                    match run(&world, &out, &|| {}) {
+                        Ok(_) => Outcome::Ran,
+                        Err(RunError::Stopped { results, .. }) => Outcome::Stopped(results),
+                        Err(RunError::Interrupted { .. }) if stop.is_raised() => {
+                            Outcome::Interrupted
+                        }
+                        Err(e) => Outcome::Failed(e.to_string()),
+                    }
+                }
             });
             let _ = send.send(outcome.map_err(|p| {
                 p.downcast_ref::<String>()
@@ -617,12 +727,19 @@ fn run_case(scenes: &[Scene], case: &Case) -> Result<usize, TestCaseError> {
         });
     }
     let describe = || files.describe(&case.mutations);
-    let outcome = match receive.recv_timeout(TIMEOUT) {
-        Err(_) => {
-            // The thread is left running: the test fails anyway.
+    let outcome = match answer(&receive, stop, case.interrupt) {
+        Err(waited) => {
+            // Raised: the thread stops soon (else it is left running); the case fails anyway.
+            stop.raise();
+            let stopped = receive.recv_timeout(STOP_GRACE).is_ok();
             std::mem::forget(dir);
             return Err(TestCaseError::fail(format!(
-                "no answer after {TIMEOUT:?} (a hang)\n{}",
+                "no answer after {waited} (a hang); raising its interrupt {}\n{}",
+                if stopped {
+                    "stopped it"
+                } else {
+                    "did not stop it"
+                },
                 describe()
             )));
         }
@@ -641,6 +758,7 @@ fn run_case(scenes: &[Scene], case: &Case) -> Result<usize, TestCaseError> {
         Outcome::Stopped(_) => 3,
         Outcome::Failed(_) => 4,
         Outcome::Swept(_) => 7,
+        Outcome::Interrupted => 8,
     };
     check_output(dir.path(), &files, &outcome).map_err(|problem| {
         TestCaseError::fail(format!("{problem} (outcome {outcome:?})\n{}", describe()))
@@ -698,7 +816,7 @@ fn check_output(dir: &Path, files: &Files, outcome: &Outcome) -> Result<(), Stri
                 }
             }
         }
-        Outcome::Refused | Outcome::TooLarge | Outcome::Failed(_) => {
+        Outcome::Refused | Outcome::TooLarge | Outcome::Failed(_) | Outcome::Interrupted => {
             if !entries.is_empty() {
                 return Err(format!("a run that wrote nothing left {entries:?} in out/"));
             }
@@ -832,6 +950,7 @@ fn the_bundled_scenes_run_unmutated() {
         let case = Case {
             scene: k,
             mutations: Vec::new(),
+            interrupt: None,
         };
         let outcome = run_case(&scenes, &case).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(outcome, 2, "{} did not run", scenes[k].file);
@@ -858,8 +977,13 @@ fn mutated_scenes_panic_hang_write_nan_or_leave_litter_never() {
     let strategy = (
         0..scenes.len(),
         proptest::collection::vec(mutation_strategy(), 1..=4),
+        prop_oneof![7 => Just(None), 1 => (0u64..1500).prop_map(Some)],
     )
-        .prop_map(|(scene, mutations)| Case { scene, mutations });
+        .prop_map(|(scene, mutations, interrupt)| Case {
+            scene,
+            mutations,
+            interrupt,
+        });
     let collect = std::env::var("LINKAGE_FUZZ_COLLECT").is_ok_and(|v| v == "1");
     let started = Instant::now();
     let result = runner.run(&strategy, |case| {
@@ -890,6 +1014,7 @@ fn mutated_scenes_panic_hang_write_nan_or_leave_litter_never() {
         "known issue",
         "findings",
         "swept",
+        "interrupted",
     ];
     let counts: BTreeMap<&str, usize> = names
         .iter()

@@ -335,3 +335,172 @@ fn a_closed_stdout_ends_the_run_quietly_and_writes_batch_csv() {
     }
     assert!(hidden(&out).is_empty(), "{:?}", hidden(&out));
 }
+
+/// One ball prepared at a spacing of 1.5 mm (about 2 million members: some ten seconds of
+/// isosurface stuffing on a loaded machine), in `dir/fine_ball.toml`.
+fn fine_ball_scene(dir: &Path) -> PathBuf {
+    std::fs::write(dir.join("ball.obj"), ball_obj()).unwrap();
+    let scene = dir.join("fine_ball.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "fine_ball"
+[[materials]]
+name = "rubber"
+youngs_modulus = 1e7
+area = 1e-5
+[[bodies]]
+name = "ball"
+mesh = { file = "ball.obj", spacing = 0.0015 }
+[[bodies.supports]]
+inside = { min = [-0.1, -0.1, -0.1], max = [0.1, -0.045, 0.1] }
+fix = ["x", "y", "z"]
+"#,
+    )
+    .unwrap();
+    scene
+}
+
+/// Issue 33, item 2: a signal while a body is prepared from a mesh stops the preparation
+/// itself (it used to finish it first, some ten seconds): `linkage run` and `linkage prepare`
+/// exit 130 within seconds, no staging folder, nothing written, earlier results untouched.
+#[test]
+fn sigterm_and_sigint_while_preparing_a_mesh_exit_130() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = fine_ball_scene(dir.path());
+    let out = dir.path().join("out");
+    let earlier = earlier_results(dir.path(), &out, "fine_ball");
+    check_stops(&scene, &[], &out, "fine_ball", &earlier, &[0.5, 1.0]);
+    let prepared = dir.path().join("prepared");
+    let ball = dir.path().join("ball.obj");
+    for signal in [libc::SIGTERM, libc::SIGINT] {
+        let args: Vec<&std::ffi::OsStr> = vec![
+            "prepare".as_ref(),
+            "--spacing".as_ref(),
+            "0.0015".as_ref(),
+            "--out".as_ref(),
+            prepared.as_os_str(),
+            ball.as_os_str(),
+        ];
+        let s = interrupt(&args, Duration::from_millis(500), signal);
+        assert_ne!(s.code, Some(-1), "prepare ended before signal {signal}");
+        assert_eq!(s.code, Some(130), "signal {signal}: {}", s.stderr);
+        assert!(
+            s.seconds < 5.0,
+            "signal {signal}: {:.2} s to stop",
+            s.seconds
+        );
+        assert!(
+            s.stderr.contains("interrupted while preparing"),
+            "{}",
+            s.stderr
+        );
+        let written = std::fs::read_dir(&prepared).map_or(0, |r| r.count());
+        assert_eq!(written, 0, "prepare wrote files after signal {signal}");
+    }
+}
+
+/// A 2D lattice of 200 × 100 cells (some 80,000 members) in 20 steps, in `dir/plate.toml`:
+/// its ParaView files take several seconds to write.
+fn plate_scene(dir: &Path) -> PathBuf {
+    let scene = dir.join("plate.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "plate"
+steps = 20
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "plate"
+rectangle = { width = 2.0, height = 1.0, cells = [200, 100] }
+[[bodies.supports]]
+on_line = { point = [0.0, 0.0], direction = [0.0, 1.0] }
+fix = ["x", "y"]
+[[bodies.loads]]
+on_line = { point = [2.0, 0.0], direction = [0.0, 1.0] }
+total_force = [0.0, -1e3]
+"#,
+    )
+    .unwrap();
+    scene
+}
+
+/// The names and bytes of the files in `dir`, sorted.
+fn contents(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| {
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// Issue 33, item 2: a signal while the ParaView files are written (`linkage render --vtk` and
+/// `linkage run --vtk`) stops the writing before the next file: exit 130 within seconds, the
+/// earlier `vtk/` as it was, no staging folder.
+#[test]
+fn sigterm_and_sigint_while_writing_vtk_exit_130_and_keep_the_old_vtk() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = plate_scene(dir.path());
+    let out = dir.path().join("out");
+    let o = linkage()
+        .args(["run".as_ref(), scene.as_os_str(), "--vtk".as_ref()])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let results = out.join("plate");
+    let vtk = contents(&results.join("vtk"));
+    assert_eq!(vtk.len(), 22, "21 steps and the collection");
+    let earlier = std::fs::read(results.join("summary.json")).unwrap();
+    for (k, signal) in [libc::SIGTERM, libc::SIGINT].into_iter().enumerate() {
+        let args: Vec<&std::ffi::OsStr> = vec![
+            "render".as_ref(),
+            results.as_os_str(),
+            "--vtk".as_ref(),
+            "--vtk-ascii".as_ref(),
+            "--no-png".as_ref(),
+            "--no-gif".as_ref(),
+        ];
+        let s = interrupt(&args, Duration::from_millis(700 + 500 * k as u64), signal);
+        let what = format!("render --vtk, signal {signal}");
+        assert_ne!(s.code, Some(-1), "{what}: ended before the signal");
+        assert_eq!(s.code, Some(130), "{what}: {}", s.stderr);
+        assert!(s.seconds < 5.0, "{what}: {:.2} s to stop", s.seconds);
+        assert!(
+            s.stderr.contains("interrupted while writing the VTK files"),
+            "{what}: {}",
+            s.stderr
+        );
+        assert!(
+            hidden(&results).is_empty(),
+            "{what}: {:?}",
+            hidden(&results)
+        );
+        assert!(
+            contents(&results.join("vtk")) == vtk,
+            "{what}: vtk/ changed"
+        );
+    }
+    // The whole run with --vtk: the steps take about a second, the VTK files several.
+    check_stops(
+        &scene,
+        &["--vtk", "--rerun"],
+        &out,
+        "plate",
+        &earlier,
+        &[2.0, 3.0],
+    );
+    assert!(
+        contents(&results.join("vtk")) == vtk,
+        "run --vtk: vtk/ changed"
+    );
+}

@@ -4,8 +4,9 @@ use crate::contact::Obstacle;
 use crate::linkage::generators;
 use crate::linkage::prepare::PrepareReport;
 use crate::linkage::{
-    Behaviour, Body, Dimension, Failure, Geometry, Kinematics, Material, Member, NewtonSettings,
-    NodalLoad, PathMethod, Scatter, Schedule, Softening, SolverChoice, SolverSettings, Support,
+    Behaviour, Body, Dimension, Failure, Geometry, Interrupt, Kinematics, Material, Member,
+    NewtonSettings, NodalLoad, PathMethod, Scatter, Schedule, Softening, SolverChoice,
+    SolverSettings, Support,
 };
 use crate::scene::bounds::{check_lengths, MAX_LENGTH};
 use crate::scene::contact_pairs::friction_settings;
@@ -155,10 +156,27 @@ pub fn build_world(text: &str, path: &Path) -> Result<World, SceneError> {
 /// [`build_world`], reading the paper's files (`nodes`, `links`, `patches`) held in `files`
 /// instead of the disk where `files` has their path (the Python package's bodies from arrays).
 pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<World, SceneError> {
+    build_world_from(text, path, files, Interrupt::default())
+}
+
+/// [`build_world`], stopped by `stop` (a run's interrupt: SIGINT, SIGTERM) while a body is
+/// prepared from a mesh: then an error saying so. The world's solves do not read `stop`: give it
+/// to them with [`World::set_interrupt`].
+pub fn build_world_until(text: &str, path: &Path, stop: Interrupt) -> Result<World, SceneError> {
+    build_world_from(text, path, &InlineFiles::default(), stop)
+}
+
+/// [`build_world_with`] and [`build_world_until`] in one.
+fn build_world_from(
+    text: &str,
+    path: &Path,
+    files: &InlineFiles,
+    stop: Interrupt,
+) -> Result<World, SceneError> {
     let started = std::time::Instant::now();
     let spec: SceneSpec = toml::from_str(text).map_err(|e| SceneError::Parse {
         path: path.to_path_buf(),
-        message: e.to_string().trim_end().to_string(),
+        message: crate::scene::toml_error::scene_toml_message(text, &e),
     })?;
     let at = |span: std::ops::Range<usize>, message: String| SceneError::At {
         path: path.to_path_buf(),
@@ -255,7 +273,14 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
             Some(_) => None,
             None => Some(spec.steps),
         };
-        let body = build_body(b, &materials, (text, path, files), steps, &at, &mut notes)?;
+        let body = build_body(
+            b,
+            &materials,
+            (text, path, files, stop),
+            steps,
+            &at,
+            &mut notes,
+        )?;
         if let Some(r) = notes.report {
             prepared.insert(body.name.clone(), r);
         }
@@ -584,7 +609,7 @@ struct BodyNotes {
 fn build_body(
     spanned: &Spanned<BodySpec>,
     materials: &[Material],
-    (text, scene, files): (&str, &Path, &InlineFiles),
+    (text, scene, files, stop): (&str, &Path, &InlineFiles, Interrupt),
     steps: Option<usize>,
     at: &dyn Fn(std::ops::Range<usize>, String) -> SceneError,
     notes: &mut BodyNotes,
@@ -839,7 +864,7 @@ fn build_body(
                 "`patches` goes with `nodes` and `links` files, not with a generator".to_string(),
             ));
         }
-        let prepared = prepared_geometry(spec, folder).map_err(&here)?;
+        let prepared = prepared_geometry(spec, folder, stop).map_err(&here)?;
         let geometry: Geometry = if let Some(p) = prepared {
             notes.report = Some(p.report);
             Ok(p.geometry)
@@ -870,17 +895,11 @@ fn build_body(
             "patches are for 3D bodies; this body's nodes have 2 coordinates".to_string(),
         ));
     }
-    let generator = [
-        "disk",
-        "rectangle",
-        "cylindrical_shell",
-        "box_lattice",
-        "mesh",
-        "outline",
-    ]
-    .into_iter()
-    .zip(generated_by(spec))
-    .find_map(|(key, g)| g.then_some(key));
+    let generator = crate::scene::toml_error::GENERATORS
+        .iter()
+        .copied()
+        .zip(generated_by(spec))
+        .find_map(|(key, g)| g.then_some(key));
     if let (Some(key), Some((n, v))) = (generator, beyond_bound(&body.nodes)) {
         return Err(here(format!(
             "`{key}` places node {} at the coordinate {v:e} m, too large to square (lengths and contact forces would overflow): give sizes in metres, within ±{MAX_LENGTH:e}",

@@ -61,10 +61,16 @@ pub fn free_disk(folder: &Path) -> Option<u64> {
 /// cannot be asked): the estimate, what the machine has, and what to change.
 pub fn refusal(world: &World, out: &Path, keeps_steps: bool) -> Option<String> {
     let gb = |b: u64| b as f64 / 1e9;
+    // A dynamic run's steps are its stored frames ([dynamics] frames).
+    let steps = if world.dynamics.is_some() {
+        "frames"
+    } else {
+        "load steps"
+    };
     let memory = memory_estimate(world, keeps_steps);
     if let Some(have) = available_memory().filter(|&have| memory > have) {
         return Some(format!(
-            "the run would need about {:.1} GB of memory for its {} load steps (and the stored steps the pictures or VTK files need) but the machine has {:.1} GB available: use fewer load steps{}",
+            "the run would need about {:.1} GB of memory for its {} {steps} (and the stored steps the pictures or VTK files need) but the machine has {:.1} GB available: use fewer {steps}{}",
             gb(memory),
             world.steps,
             gb(have),
@@ -74,7 +80,7 @@ pub fn refusal(world: &World, out: &Path, keeps_steps: bool) -> Option<String> {
     let disk = disk_estimate(world);
     if let Some(free) = free_disk(out).filter(|&free| disk > free) {
         return Some(format!(
-            "the run would write about {:.1} GB of step files but {} has {:.1} GB free: write fewer steps with [output] every = k or last_only = true, or use fewer load steps",
+            "the run would write about {:.1} GB of step files but {} has {:.1} GB free: write fewer steps with [output] every = k or last_only = true, or use fewer {steps}",
             gb(disk),
             out.display(),
             gb(free)

@@ -1,6 +1,6 @@
 //! Scene files, the load-step driver and the result files.
 
-pub use self::build::{build_world, build_world_with, load_scene, SceneError};
+pub use self::build::{build_world, build_world_until, build_world_with, load_scene, SceneError};
 pub use self::check::{
     check_world, obstacle_offset_bytes, output_warning, step_file_bytes, stored_steps, CheckReport,
     BYTES_PER_VALUE, NPZ_BYTES_PER_VALUE, OUTPUT_WARNING_BYTES,
@@ -75,6 +75,7 @@ mod stepper;
 mod stored_run;
 mod strain_warning;
 pub mod sweep;
+mod toml_error;
 mod vtk;
 mod vtu_arrays;
 mod world;

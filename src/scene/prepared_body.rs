@@ -3,8 +3,8 @@
 //! paper's files of the result.
 
 use crate::contact::orient_outward;
-use crate::linkage::prepare::{prepare_mesh, prepare_outline, PreparedBody};
-use crate::linkage::Dimension;
+use crate::linkage::prepare::{prepare_mesh_until, prepare_outline, PreparedBody};
+use crate::linkage::{Dimension, Interrupt};
 use crate::scene::mesh_file::read_mesh;
 use crate::scene::paper_files::{write_links, write_nodes, write_patches};
 use crate::Real;
@@ -50,8 +50,9 @@ pub fn read_outline(path: &Path) -> Result<Vec<Vec<[Real; 2]>>, String> {
 }
 
 /// Prepare a body from `path`: a closed OBJ or STL mesh (3D, turned outward first) or an
-/// outline file (2D, any other extension), at `spacing` (m). Errors name the file.
-pub fn prepare_file(path: &Path, spacing: Real) -> Result<PreparedBody, String> {
+/// outline file (2D, any other extension), at `spacing` (m). Errors name the file. Once `stop`
+/// is raised (SIGINT, SIGTERM) a mesh's preparation ends early with an error saying so.
+pub fn prepare_file(path: &Path, spacing: Real, stop: Interrupt) -> Result<PreparedBody, String> {
     let extension = path
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
@@ -66,7 +67,7 @@ pub fn prepare_file(path: &Path, spacing: Real) -> Result<PreparedBody, String> 
                 path.display()
             )
         })?;
-        prepare_mesh(&vertices, &oriented.triangles, spacing)
+        prepare_mesh_until(&vertices, &oriented.triangles, spacing, stop)
             .map_err(|e| format!("{}: {e}", path.display()))
     } else {
         let loops = read_outline(path)?;
@@ -97,14 +98,15 @@ pub fn write_prepared(
 }
 
 /// The body a scene's `mesh` or `outline` key prepares (files relative to `folder`), or `None`
-/// when it gives neither. Errors name the key.
+/// when it gives neither. Errors name the key. `stop`: as for [`prepare_file`].
 pub(crate) fn prepared_geometry(
     spec: &crate::scene::spec::BodySpec,
     folder: &Path,
+    stop: Interrupt,
 ) -> Result<Option<PreparedBody>, String> {
     if let Some(m) = &spec.mesh {
         let path = folder.join(&m.file);
-        return prepare_file_checked(&path, "mesh", &m.file, m.spacing).map(Some);
+        return prepare_file_checked(&path, "mesh", &m.file, m.spacing, stop).map(Some);
     }
     let Some(o) = &spec.outline else {
         return Ok(None);
@@ -130,6 +132,7 @@ fn prepare_file_checked(
     key: &str,
     file: &str,
     spacing: Real,
+    stop: Interrupt,
 ) -> Result<PreparedBody, String> {
     if !path.is_file() {
         return Err(format!(
@@ -146,5 +149,5 @@ fn prepare_file_checked(
             "`{key}` file {file:?}: give an .stl or .obj file (a 2D outline goes in `outline`)"
         ));
     }
-    prepare_file(path, spacing).map_err(|e| format!("`{key}`: {e}"))
+    prepare_file(path, spacing, stop).map_err(|e| format!("`{key}`: {e}"))
 }

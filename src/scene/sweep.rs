@@ -99,6 +99,13 @@ pub fn expand_sweep(text: &str, path: &Path) -> Result<Vec<Variant>, SceneError>
                 .into(),
         ));
     }
+    let counts: Vec<usize> = match mode {
+        SweepMode::Grid => keys.iter().map(|(_, v)| v.len()).collect(),
+        SweepMode::Zip => vec![keys[0].1.len()],
+    };
+    if let Some(problem) = too_many_variants(&counts, text.len()) {
+        return Err(at("", problem));
+    }
     let combinations = match mode {
         SweepMode::Grid => grid(&keys),
         SweepMode::Zip => {
@@ -172,6 +179,44 @@ pub fn with_values(
         values: values.to_vec(),
         text,
     })
+}
+
+/// Variants a sweep may make: each is a scene run into its own folder and a row of
+/// `batch.csv`, and its scene text is held in memory while the batch is planned.
+pub const MAX_VARIANTS: u64 = 1_000_000;
+
+/// Bytes a variant takes besides its scene text while the batch is planned (its job, values and
+/// folder name), and at least on disk once run (`summary.json`, the model and step 0).
+pub const VARIANT_OVERHEAD_BYTES: u64 = 4096;
+
+/// Why a sweep of `counts` values per key (a grid: their product; zip: one count) over a scene of
+/// `text_bytes` cannot be planned: more than [`MAX_VARIANTS`] variants, or their scene texts
+/// more than the machine's available memory; `None` when it fits. Checked before any variant is
+/// made, with the memory and disk estimates in the message.
+pub fn too_many_variants(counts: &[usize], text_bytes: usize) -> Option<String> {
+    let n = counts
+        .iter()
+        .fold(1u128, |n, &c| n.saturating_mul(c as u128));
+    let each = text_bytes as u64 + VARIANT_OVERHEAD_BYTES;
+    let memory = n as f64 * each as f64;
+    let available = crate::scene::fits_machine::available_memory();
+    let over_memory = available.is_some_and(|have| memory > have as f64);
+    if n <= MAX_VARIANTS as u128 && !over_memory {
+        return None;
+    }
+    let shape = counts
+        .iter()
+        .map(usize::to_string)
+        .collect::<Vec<_>>()
+        .join(" × ");
+    let have = available.map_or_else(String::new, |b| {
+        format!(" (the machine has {:.1} GB available)", b as f64 / 1e9)
+    });
+    Some(format!(
+        "makes {n} variants ({shape} values): planning them would take about {:.3e} GB of memory{have} and their folders at least {:.3e} GB of disk; at most {MAX_VARIANTS} variants (and their scenes within the memory): sweep fewer values, or split the sweep into several scenes",
+        memory / 1e9,
+        n as f64 * VARIANT_OVERHEAD_BYTES as f64 / 1e9,
+    ))
 }
 
 /// Every combination of one value per key, the last key fastest.
@@ -446,6 +491,24 @@ force = [1.0, 2.0]
                 text: text.to_string()
             }]
         );
+    }
+
+    #[test]
+    fn a_grid_of_a_million_by_a_million_is_refused_with_its_estimates() {
+        let problem = too_many_variants(&[1_000_000, 1_000_000], 1000).unwrap();
+        // 1e12 variants × (1000 + 4096) B = 5.096e15 B = 5.096e6 GB; on disk 4.096e6 GB.
+        for part in [
+            "1000000000000 variants",
+            "1000000 × 1000000",
+            "5.096e6 GB of memory",
+            "4.096e6 GB of disk",
+            "at most 1000000",
+        ] {
+            assert!(problem.contains(part), "{part:?} in {problem}");
+        }
+        assert!(too_many_variants(&[100, 100], 1000).is_none());
+        assert!(too_many_variants(&[1000, 1001], 1000).is_some());
+        assert!(too_many_variants(&[usize::MAX, usize::MAX, usize::MAX], 10).is_some());
     }
 
     #[test]

@@ -21,6 +21,7 @@
 //! after it, holding its number.
 
 use crate::contact::cut_by_z0;
+use crate::linkage::Interrupt;
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::model_file::{ModelBody, ModelFile};
 use crate::scene::publish::{publish_keeping, remove_stale, staging_dir};
@@ -52,6 +53,12 @@ pub enum VtkError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// Asked to stop (SIGINT, SIGTERM) while writing: `vtk/` is as it was.
+    #[error("{dir}: interrupted while writing the VTK files: vtk/ is as it was")]
+    Interrupted {
+        /// The results folder.
+        dir: PathBuf,
+    },
 }
 
 /// Write `dir/vtk/NNNN.vtu` for every stored step of `run` and `dir/vtk/<scene>.pvd`, and
@@ -63,16 +70,18 @@ pub enum VtkError {
 ///
 /// The files are written into a staging folder that then replaces `vtk/` as a whole, so `vtk/`
 /// never holds files of an older run beside these (a user's other files in it, not `.vtu` or
-/// `.pvd`, are kept), and a write that fails leaves the old `vtk/` as it was.
+/// `.pvd`, are kept), and a write that fails leaves the old `vtk/` as it was. Once `stop` is
+/// raised the writing stops before the next file ([`VtkError::Interrupted`]), the same way.
 pub fn write_vtk(
     run: &RunResults,
     dir: &Path,
     encoding: VtkEncoding,
+    stop: Interrupt,
 ) -> Result<Vec<PathBuf>, VtkError> {
     let final_dir = dir.join("vtk");
     remove_stale(dir, "vtk");
     let staging = staging_dir(dir, "vtk");
-    let written = write_vtk_into(run, dir, &staging, encoding).and_then(|written| {
+    let written = write_vtk_into(run, dir, &staging, encoding, stop).and_then(|written| {
         publish_keeping(&staging, &final_dir, &is_vtk_file).map_err(|source| VtkError::Write {
             path: final_dir.clone(),
             source,
@@ -102,7 +111,17 @@ fn write_vtk_into(
     results_dir: &Path,
     dir: &Path,
     encoding: VtkEncoding,
+    stop: Interrupt,
 ) -> Result<Vec<PathBuf>, VtkError> {
+    let stopped = || {
+        if stop.is_raised() {
+            Err(VtkError::Interrupted {
+                dir: results_dir.to_path_buf(),
+            })
+        } else {
+            Ok(())
+        }
+    };
     std::fs::create_dir_all(dir).map_err(|source| VtkError::Write {
         path: dir.to_path_buf(),
         source,
@@ -110,6 +129,7 @@ fn write_vtk_into(
     let mut written = Vec::new();
     let mut entries = Vec::new();
     for result in &run.steps {
+        stopped()?;
         let step = result.step;
         let name = format!("{}.vtu", run.stem(step));
         let path = dir.join(&name);
@@ -125,6 +145,7 @@ fn write_vtk_into(
     let mut obstacle_files = Vec::new();
     if !run.model.obstacles.is_empty() {
         for result in &run.steps {
+            stopped()?;
             let step = result.step;
             let file = obstacles_vtu_file(&run.model, step, encoding).map_err(|problem| {
                 VtkError::BadModel {
@@ -160,6 +181,7 @@ fn write_vtk_into(
         }
     }
     pvd.push_str("  </Collection>\n</VTKFile>\n");
+    stopped()?;
     let path = dir.join(format!("{}.pvd", run.model.scene));
     write_atomically(&path, pvd.as_bytes()).map_err(|source| VtkError::Write {
         path: path.clone(),

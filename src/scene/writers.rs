@@ -152,9 +152,11 @@ pub(crate) fn write_after_steps(
         digits: step_digits(world.steps),
     };
     if world.pictures.vtk {
-        write_vtk(&run, dir, world.pictures.vtk_encoding).map_err(|e| RunError::Draw {
-            path: dir.join("vtk"),
-            source: Box::new(e),
+        write_vtk(&run, dir, world.pictures.vtk_encoding, world.interrupt()).map_err(|e| {
+            RunError::Draw {
+                path: dir.join("vtk"),
+                source: Box::new(e),
+            }
         })?;
     }
     phases.writing += t.elapsed().as_secs_f64();

@@ -23,12 +23,12 @@ pub enum PrepareError {
         limit: Real,
     },
     /// A spacing so small that the body would not fit in memory.
-    #[error("spacing = {spacing} m would make about {members} members (about {gigabytes:.1} GB while preparing, at most {limit_gigabytes:.1} GB): give a spacing of at least {smallest} m")]
+    #[error("spacing = {spacing} m would make about {members:.3e} members (about {gigabytes:.3e} GB while preparing, at most {limit_gigabytes:.1} GB): give a spacing of at least {smallest} m")]
     TooLarge {
         /// The spacing given, m.
         spacing: Real,
-        /// Estimated members.
-        members: u64,
+        /// Estimated members (a float: an absurd spacing gives more than a u64 holds).
+        members: Real,
         /// Estimated memory while preparing, GB.
         gigabytes: Real,
         /// The memory allowed, GB.
@@ -36,6 +36,9 @@ pub enum PrepareError {
         /// The smallest spacing within the limit, m.
         smallest: Real,
     },
+    /// Asked to stop (SIGINT, SIGTERM) while preparing: nothing was made.
+    #[error("interrupted while preparing the body: nothing was made")]
+    Interrupted,
     /// A triangle whose corners are (nearly) on one line.
     #[error("face {face} (vertices {}, {}, {}) has no area: remove it or merge its vertices", .vertices[0], .vertices[1], .vertices[2])]
     DegenerateFace {

@@ -9,7 +9,7 @@ use super::self_intersection::check_self_intersection;
 use super::stuffing::stuff;
 use super::tet_mesh::TetMesh;
 use super::PrepareError;
-use crate::linkage::Geometry;
+use crate::linkage::{Geometry, Interrupt};
 use crate::Real;
 use nalgebra::Vector3;
 
@@ -52,6 +52,25 @@ pub fn prepare_mesh(
     triangles: &[[usize; 3]],
     spacing: Real,
 ) -> Result<PreparedBody, PrepareError> {
+    prepare_mesh_until(vertices, triangles, spacing, Interrupt::default())
+}
+
+/// [`prepare_mesh`], stopped by `stop` (a run's interrupt: SIGINT, SIGTERM).
+/// Once `stop` is raised the work ends between its phases ([`PrepareError::Interrupted`]); the
+/// lattice's vertices are then skipped, so it ends within a fraction of a second.
+pub fn prepare_mesh_until(
+    vertices: &[Vector3<Real>],
+    triangles: &[[usize; 3]],
+    spacing: Real,
+    stop: Interrupt,
+) -> Result<PreparedBody, PrepareError> {
+    let stopped = || {
+        if stop.is_raised() {
+            Err(PrepareError::Interrupted)
+        } else {
+            Ok(())
+        }
+    };
     if !(spacing.is_finite() && spacing > 0.0) {
         return Err(PrepareError::BadSpacing { spacing });
     }
@@ -74,7 +93,9 @@ pub fn prepare_mesh(
             });
         }
     }
+    stopped()?;
     check_self_intersection(vertices, triangles)?;
+    stopped()?;
     let volume = enclosed_volume(vertices, triangles);
     if volume.is_nan() || volume <= 1e-12 * diagonal.powi(3) {
         return Err(PrepareError::NoVolume { volume });
@@ -103,7 +124,7 @@ pub fn prepare_mesh(
         let smallest = spacing * (bytes / MEMORY_LIMIT as Real).cbrt() * 1.01;
         return Err(PrepareError::TooLarge {
             spacing,
-            members: members as u64,
+            members,
             gigabytes: bytes / 1e9,
             limit_gigabytes: MEMORY_LIMIT as Real / 1e9,
             smallest: (smallest * 1e6).ceil() / 1e6,
@@ -115,8 +136,10 @@ pub fn prepare_mesh(
         cells: [cells.x as usize, cells.y as usize, cells.z as usize],
     };
     let surface = ClosedSurface::new(vertices, triangles, 1e-9 * spacing)?;
-    let tets: TetMesh = stuff(&surface, &lattice);
+    stopped()?;
+    let tets: TetMesh = stuff(&surface, &lattice, stop).ok_or(PrepareError::Interrupted)?;
     let (geometry, cells) = tets.into_geometry(spacing)?;
+    stopped()?;
     let report = report_3d(&geometry, &cells, spacing, volume);
     Ok(PreparedBody {
         geometry,

@@ -159,7 +159,7 @@ pub fn prepare_outline(
         let smallest = spacing * (triangles / MAX_TRIANGLES as Real).sqrt() * 1.01;
         return Err(PrepareError::TooLarge {
             spacing,
-            members: (1.5 * triangles) as u64,
+            members: 1.5 * triangles,
             gigabytes: triangles * 400.0 / 1e9,
             limit_gigabytes: MAX_TRIANGLES as Real * 400.0 / 1e9,
             smallest: (smallest * 1e6).ceil() / 1e6,

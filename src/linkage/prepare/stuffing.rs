@@ -11,6 +11,7 @@
 use super::bcc_lattice::{BccLattice, EdgeKind};
 use super::closed_surface::{ClosedSurface, Side};
 use super::tet_mesh::TetMesh;
+use crate::linkage::Interrupt;
 use crate::Real;
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -36,13 +37,21 @@ struct Cut {
 }
 
 /// Fill `surface` over `lattice` with tetrahedra: node ids below the lattice's vertex count
-/// are (possibly warped) lattice vertices, the rest cut points.
-pub(crate) fn stuff(surface: &ClosedSurface, lattice: &BccLattice) -> TetMesh {
+/// are (possibly warped) lattice vertices, the rest cut points. `None` once `stop` is raised:
+/// the vertices left are then skipped and the work ends at the next phase.
+pub(crate) fn stuff(
+    surface: &ClosedSurface,
+    lattice: &BccLattice,
+    stop: Interrupt,
+) -> Option<TetMesh> {
     let count = lattice.vertex_count();
     let (mut side, mut position): (Vec<Side>, Vec<Vector3<Real>>) = (0..count)
         .into_par_iter()
         .map(|id| {
             let p = lattice.position(id);
+            if stop.is_raised() {
+                return (Side::Outside, p);
+            }
             let (s, nearest) = surface.side(&p);
             // A vertex on the surface is moved onto it exactly.
             (s, if s == Side::On { nearest } else { p })
@@ -56,6 +65,9 @@ pub(crate) fn stuff(surface: &ClosedSurface, lattice: &BccLattice) -> TetMesh {
         (Side::Outside, Side::Inside) => crossing.push(([b, a], kind)),
         _ => {}
     });
+    if stop.is_raised() {
+        return None;
+    }
     let mut cuts: Vec<Cut> = crossing
         .into_par_iter()
         .map(|(ends, kind)| {
@@ -109,6 +121,9 @@ pub(crate) fn stuff(surface: &ClosedSurface, lattice: &BccLattice) -> TetMesh {
         start = end;
     }
 
+    if stop.is_raised() {
+        return None;
+    }
     // Node ids: lattice vertices, then the cuts that survived.
     let mut cut_id: HashMap<(usize, usize), usize> = HashMap::new();
     for (c, cut) in cuts.iter().enumerate() {
@@ -177,10 +192,10 @@ pub(crate) fn stuff(surface: &ClosedSurface, lattice: &BccLattice) -> TetMesh {
             _ => unreachable!("four signs always fall in one of the cases above"),
         }
     });
-    TetMesh {
+    (!stop.is_raised()).then_some(TetMesh {
         nodes: position,
         tets,
-    }
+    })
 }
 
 /// The pyramid over the quadrilateral `quad` (in cyclic order) with apex `apex` as two

@@ -6,7 +6,7 @@ use crate::scene::batch::jobs::Job;
 use crate::scene::batch::row::{complete_summary, job_row};
 use crate::scene::batch::table::Row;
 use crate::scene::{
-    build_world, run_into, write_vtk, DrawResults, RunError, RunResults, Summary, World,
+    build_world_until, run_into, write_vtk, DrawResults, RunError, RunResults, Summary, World,
 };
 use std::path::Path;
 
@@ -80,13 +80,14 @@ pub fn run_job(
         );
     }
     let started = std::time::Instant::now();
-    let built = build_world(text, &job.scene).map_err(|e| {
+    let built = build_world_until(text, &job.scene, stop).map_err(|e| {
         let message = e.to_string();
         job.describe_error(&message)
     });
     let mut world = match built {
-        // Asked to stop while the world was built (meshes prepared): it does not run.
-        Ok(_) if stop.is_raised() => {
+        // Asked to stop while the world was built (meshes prepared): it does not run, and a
+        // preparation cut short is no error of the scene.
+        _ if stop.is_raised() => {
             let why = RunError::Interrupted {
                 scene: job.scene.clone(),
                 step: 0,
@@ -186,7 +187,8 @@ fn draw_stored(
 ) -> Result<(), String> {
     let run = RunResults::read(folder).map_err(|e| e.to_string())?;
     if world.pictures.vtk {
-        write_vtk(&run, folder, world.pictures.vtk_encoding).map_err(|e| e.to_string())?;
+        write_vtk(&run, folder, world.pictures.vtk_encoding, world.interrupt())
+            .map_err(|e| e.to_string())?;
     }
     if let Some(draw) = draw.filter(|_| world.pictures.png || world.pictures.gif) {
         // An interrupted drawing says so itself (and keeps the pictures as they were).
