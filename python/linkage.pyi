@@ -38,9 +38,18 @@ def run(path: _Path, out: _Path = "out", progress: Optional[_Progress] = None) -
 class Material:
     """A material: `[[materials]]` of a scene file."""
 
-    def __init__(self, name: str, youngs_modulus: float, area: float, **keys: Any) -> None:
-        """`youngs_modulus` E in Pa and `area` A in m² of its members; every other
-        `[[materials]]` key as a keyword (`strength`, `tensile_strength`,
+    def __init__(
+        self,
+        name: str,
+        youngs_modulus: float,
+        area: Optional[float] = None,
+        continuum_modulus: Optional[float] = None,
+        **keys: Any,
+    ) -> None:
+        """`youngs_modulus` E in Pa and `area` A in m² of its members, or instead of `area`
+        `continuum_modulus` in Pa: the Young's modulus a 3D body of this material has as a
+        solid (its members' area is chosen per body to give it; give one of the two). Every
+        other `[[materials]]` key as a keyword (`strength`, `tensile_strength`,
         `compressive_strength` in Pa, `behaviour`, `density` in kg/m³, `failure`, `scatter`,
         `softening`)."""
     @property

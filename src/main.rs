@@ -712,6 +712,9 @@ fn print_check(path: &Path, report: &linkage::scene::CheckReport) {
     for f in &report.found {
         say!("      found: {f}");
     }
+    for s in &report.solids {
+        say!("      solid: {s}");
+    }
     for note in &report.notes {
         say!("      not checked: {note}");
     }
@@ -734,6 +737,26 @@ fn prepare(input: &Path, spacing: f64, out: &Path) -> Result<()> {
         say!("wrote {}", path.display());
     }
     say!("{}", body.report);
+    // The lattice as a solid, for members of E A = 1 N: its moduli scale with E A.
+    if body.geometry.dimension == linkage::linkage::Dimension::Three {
+        let unit = linkage::linkage::Body::from_geometry(
+            &stem,
+            body.geometry.clone(),
+            linkage::linkage::Material::new("unit", 1.0, 1.0),
+        );
+        match linkage::linkage::homogenize::effective_elasticity(&unit, body.report.reference) {
+            Ok(s) => say!(
+                "as a solid (uniaxial tests of the lattice): Young's modulus {:.4e} × E A per m² (x {:.4e}, y {:.4e}, z {:.4e}), Poisson's ratio {:.3}: for a solid of modulus E_c give members of modulus E the area E_c / (E × {:.4e}), or continuum_modulus = E_c",
+                s.youngs_modulus,
+                s.youngs_moduli[0],
+                s.youngs_moduli[1],
+                s.youngs_moduli[2],
+                s.poisson_ratio,
+                s.youngs_modulus
+            ),
+            Err(e) => say!("as a solid: {e}"),
+        }
+    }
     Ok(())
 }
 

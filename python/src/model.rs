@@ -33,21 +33,29 @@ impl Material {
 #[pymethods]
 impl Material {
     /// A material named `name` with Young's modulus `youngs_modulus` (Pa) and cross-section
-    /// `area` (m²) of its members; every other `[[materials]]` key as a keyword (`strength`,
-    /// `tensile_strength`, `compressive_strength` in Pa, `behaviour`, `density` in kg/m³,
-    /// `failure`, `scatter`, `softening`: see docs/SCENES.md).
+    /// `area` (m²) of its members, or instead of `area` `continuum_modulus` (Pa: the modulus a
+    /// 3D body of this material has as a solid, its area chosen to give it); every other
+    /// `[[materials]]` key as a keyword (`strength`, `tensile_strength`,
+    /// `compressive_strength` in Pa, `behaviour`, `density` in kg/m³, `failure`, `scatter`,
+    /// `softening`: see docs/SCENES.md).
     #[new]
-    #[pyo3(signature = (name, youngs_modulus, area, **keys))]
+    #[pyo3(signature = (name, youngs_modulus, area = None, continuum_modulus = None, **keys))]
     fn new(
         name: String,
         youngs_modulus: f64,
-        area: f64,
+        area: Option<f64>,
+        continuum_modulus: Option<f64>,
         keys: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
         let mut table = Table::new();
         table.insert("name".into(), Value::String(name));
         table.insert("youngs_modulus".into(), Value::Float(youngs_modulus));
-        table.insert("area".into(), Value::Float(area));
+        if let Some(a) = area {
+            table.insert("area".into(), Value::Float(a));
+        }
+        if let Some(e) = continuum_modulus {
+            table.insert("continuum_modulus".into(), Value::Float(e));
+        }
         kwargs_into(&mut table, keys, "Material")?;
         Ok(Material { table })
     }

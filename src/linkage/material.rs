@@ -77,6 +77,9 @@ pub struct Material {
     pub scatter: Option<Scatter>,
     /// Saw-tooth softening of breaking members (none: they break at their strength).
     pub softening: Option<Softening>,
+    /// Young's modulus the body should have as a solid, Pa (`continuum_modulus`): when given,
+    /// `area` is chosen per body to give it (see [`crate::linkage::homogenize`]).
+    pub continuum_modulus: Option<Real>,
 }
 
 impl Material {
@@ -92,6 +95,7 @@ impl Material {
             failure: Failure::Mark,
             scatter: None,
             softening: None,
+            continuum_modulus: None,
         }
     }
 

@@ -48,6 +48,7 @@ mod equilibrium;
 pub mod fracture;
 pub mod generators;
 mod geometry;
+pub mod homogenize;
 mod interrupt;
 mod iterative_solver;
 mod kinematics;

@@ -2,6 +2,7 @@
 
 use crate::contact::Obstacle;
 use crate::linkage::generators;
+use crate::linkage::homogenize::{continuum_volume, fit_continuum_modulus};
 use crate::linkage::prepare::PrepareReport;
 use crate::linkage::{
     Behaviour, Body, Dimension, Failure, Geometry, Interrupt, Kinematics, Material, Member,
@@ -265,6 +266,7 @@ fn build_world_from(
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut bodies: Vec<Body> = Vec::new();
     let mut prepared = std::collections::BTreeMap::new();
+    let mut solids = std::collections::BTreeMap::new();
     let mut warnings = Vec::new();
     let mut found = Vec::new();
     for b in &spec.bodies {
@@ -273,7 +275,7 @@ fn build_world_from(
             Some(_) => None,
             None => Some(spec.steps),
         };
-        let body = build_body(
+        let mut body = build_body(
             b,
             &materials,
             (text, path, files, stop),
@@ -281,6 +283,26 @@ fn build_world_from(
             &at,
             &mut notes,
         )?;
+        // The solid a prepared body models is the mesh given; any other body's, what its
+        // patches enclose (or its bounding box).
+        let volume = match (&notes.report, body.dimension) {
+            (Some(r), Dimension::Three) => r.reference,
+            _ => continuum_volume(&body),
+        };
+        let fitted = fit_continuum_modulus(&mut body, volume).map_err(|e| {
+            let line = key_line(text, b.span().start, "`material`");
+            SceneError::At {
+                path: path.to_path_buf(),
+                line,
+                message: e.to_string(),
+            }
+        })?;
+        if let Some(r) = notes.report.as_mut() {
+            r.solid = fitted;
+        }
+        if let Some(f) = fitted {
+            solids.insert(body.name.clone(), f);
+        }
         if let Some(r) = notes.report {
             prepared.insert(body.name.clone(), r);
         }
@@ -379,6 +401,7 @@ fn build_world_from(
         source: path.to_path_buf(),
         scene_digest: crate::scene::scene_and_files_digest(text, folder),
         prepared,
+        solids,
         build_seconds: started.elapsed().as_secs_f64(),
     })
 }
@@ -469,10 +492,33 @@ fn material_from(m: &MaterialSpec) -> Result<Material, String> {
             }
         }
     }
+    let area = match (m.area, m.continuum_modulus) {
+        (Some(a), None) => a,
+        (None, Some(e)) if e.is_finite() && e > 0.0 => 1.0,
+        (None, Some(e)) => {
+            return Err(format!(
+                "material '{}': continuum_modulus = {e} must be a finite positive number of Pa",
+                m.name
+            ))
+        }
+        (Some(_), Some(_)) => {
+            return Err(format!(
+                "material '{}': give either `area` (m², the members' cross-section) or `continuum_modulus` (Pa, the modulus the body should have as a solid: the area is then chosen per body), not both",
+                m.name
+            ))
+        }
+        (None, None) => {
+            return Err(format!(
+                "material '{}': give `area` (m², the members' cross-section) or `continuum_modulus` (Pa, the modulus a 3D body of this material should have as a solid)",
+                m.name
+            ))
+        }
+    };
     let material = Material {
         name: m.name.clone(),
         youngs_modulus: m.youngs_modulus,
-        area: m.area,
+        area,
+        continuum_modulus: m.continuum_modulus,
         tensile_strength: m.tensile_strength.or(m.strength),
         compressive_strength: m.compressive_strength.or(m.strength),
         behaviour: match m.behaviour.as_deref() {

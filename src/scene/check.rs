@@ -26,6 +26,9 @@ pub struct CheckReport {
     pub notes: Vec<String>,
     /// What loading the scene found and changed (mesh faces turned outward).
     pub found: Vec<String>,
+    /// Per 3D body with a closed surface (or a material with `continuum_modulus`) its Young's
+    /// modulus and Poisson's ratio as a solid ([`crate::linkage::homogenize`]).
+    pub solids: Vec<String>,
     /// What the run would do that a user may not want: the scene's own warnings
     /// ([`World::warnings`]), more than 1 GiB of step files.
     pub warnings: Vec<String>,
@@ -56,6 +59,7 @@ pub fn check_world(world: &World) -> Result<CheckReport, RunError> {
         bodies: simulation.sizes(),
         notes,
         found: world.found.clone(),
+        solids: solid_lines(world),
         warnings: world
             .warnings
             .iter()
@@ -175,4 +179,58 @@ mod tests {
             assert_eq!(stored_steps(&o, steps), counted);
         }
     }
+}
+
+/// Bodies with more members than this are not homogenized by `linkage check` (the three
+/// uniaxial tests factor the body three times).
+pub const SOLID_CHECK_MEMBERS: usize = 300_000;
+
+/// One line per 3D body that models a solid: its elasticity as one, or why it has none.
+fn solid_lines(world: &World) -> Vec<String> {
+    use crate::linkage::homogenize::{continuum_volume, effective_elasticity};
+    let mut lines = Vec::new();
+    for body in &world.bodies {
+        if let Some(s) = world.solids.get(&body.name) {
+            let area = body
+                .members
+                .first()
+                .map_or(0.0, |m| body.materials[m.material].area);
+            lines.push(format!(
+                "body '{}' (continuum_modulus: member area {area:.4e} m²): {s}",
+                body.name
+            ));
+            continue;
+        }
+        if body.dimension != crate::linkage::Dimension::Three || !is_closed(&body.patches) {
+            continue;
+        }
+        if body.members.len() > SOLID_CHECK_MEMBERS {
+            lines.push(format!(
+                "body '{}': not homogenized ({} members, more than {SOLID_CHECK_MEMBERS})",
+                body.name,
+                body.members.len()
+            ));
+            continue;
+        }
+        let volume = world
+            .prepared
+            .get(&body.name)
+            .map_or_else(|| continuum_volume(body), |r| r.reference);
+        lines.push(match effective_elasticity(body, volume) {
+            Ok(s) => format!("body '{}': {s}", body.name),
+            Err(e) => e.to_string(),
+        });
+    }
+    lines
+}
+
+/// Whether `patches` are a closed surface: not empty, every edge in exactly two of them.
+fn is_closed(patches: &[[usize; 3]]) -> bool {
+    let mut edges = std::collections::HashMap::new();
+    for &[a, b, c] in patches {
+        for (p, q) in [(a, b), (b, c), (c, a)] {
+            *edges.entry((p.min(q), p.max(q))).or_insert(0usize) += 1;
+        }
+    }
+    !patches.is_empty() && edges.values().all(|&n| n == 2)
 }

@@ -206,8 +206,12 @@ pub struct MaterialSpec {
     pub name: String,
     /// Young's modulus E, Pa.
     pub youngs_modulus: Real,
-    /// Cross-section area A, m².
-    pub area: Real,
+    /// Cross-section area A, m² (or `continuum_modulus`, not both).
+    pub area: Option<Real>,
+    /// Young's modulus the body should have as a solid, Pa: the members' area is chosen per
+    /// body so that its uniaxial tests give it (instead of `area`; 3D bodies of this one
+    /// material).
+    pub continuum_modulus: Option<Real>,
     /// Strength in tension and compression, Pa.
     pub strength: Option<Real>,
     /// Strength in tension, Pa (overrides `strength`).

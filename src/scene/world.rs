@@ -71,6 +71,9 @@ pub struct World {
     pub scene_digest: String,
     /// The quality report of each body prepared from a mesh or an outline, by body name.
     pub prepared: std::collections::BTreeMap<String, crate::linkage::prepare::PrepareReport>,
+    /// The elasticity as a solid of each body whose material gives `continuum_modulus`, by body
+    /// name: its uniaxial tests with the area chosen ([`crate::linkage::homogenize`]).
+    pub solids: std::collections::BTreeMap<String, crate::linkage::homogenize::EffectiveElasticity>,
     /// Wall time of building it: parsing the scene, reading its files, generating or
     /// preparing its bodies, s (`phases.reading` of `summary.json`).
     pub build_seconds: crate::Real,

@@ -33,6 +33,11 @@ pub struct PrepareReport {
     pub smallest_angle: Real,
     /// Largest dihedral angle (3D) or triangle angle (2D), degrees.
     pub largest_angle: Real,
+    /// The body's Young's moduli and Poisson's ratio as a solid (its uniaxial tests, see
+    /// [`crate::linkage::homogenize`]), for a body of a material with `continuum_modulus`
+    /// (none otherwise: `linkage check` and `linkage prepare` show them for any 3D body).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solid: Option<crate::linkage::homogenize::EffectiveElasticity>,
 }
 
 impl fmt::Display for PrepareReport {
@@ -74,7 +79,11 @@ impl fmt::Display for PrepareReport {
             f,
             "{angle} angle {:.2}° to {:.2}°",
             self.smallest_angle, self.largest_angle
-        )
+        )?;
+        match &self.solid {
+            Some(s) => write!(f, "\n{s}"),
+            None => Ok(()),
+        }
     }
 }
 
@@ -169,6 +178,7 @@ pub(crate) fn finish(
         longest_member: longest,
         smallest_angle: smallest_angle.to_degrees(),
         largest_angle: largest_angle.to_degrees(),
+        solid: None,
     }
 }
 
