@@ -495,3 +495,98 @@ fn a_zero_velocity_in_a_held_direction_is_fine() {
     let run = run_scene(dir.path(), &scene);
     assert!(run.status.success(), "{}", text(&run));
 }
+
+/// The outputs of a dynamic run (issue 31 item 6), on [`FALLING`] with pictures and ParaView
+/// files: `plots/energies.csv` holds exactly the summary's kinetic, strain, external work,
+/// dissipated and total energies at each stored time (to 1e-12 relative; no contact plot
+/// without contact); the `.pvd`'s `timestep`s are the stored times; the GIF shows each frame
+/// for its real time to the next (0.02 s: 2 hundredths); `batch.csv` has the dynamic columns
+/// `duration` = 0.1 s, `peak_contact_force` = 0 and `final_kinetic_energy` = the summary's.
+#[test]
+fn a_dynamic_run_plots_its_energies_and_writes_times_and_batch_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, FALLING.replace("INTEGRATOR", "newmark")).unwrap();
+    let out = dir.path().join("out");
+    let run = linkage_cmd()
+        .arg("run")
+        .arg(&path)
+        .arg("--out")
+        .arg(&out)
+        .args(["--png", "--vtk"])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", text(&run));
+    let folder = out.join("falling");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(folder.join("summary.json")).unwrap())
+            .unwrap();
+    let steps = summary["steps"].as_array().unwrap();
+    let times: Vec<f64> = steps.iter().map(|s| s["time"].as_f64().unwrap()).collect();
+    assert_eq!(times.len(), 6);
+    // The energy plot's points are the summary's, series by series.
+    let csv = std::fs::read_to_string(folder.join("plots/energies.csv")).unwrap();
+    assert!(folder.join("plots/energies.png").is_file());
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("series,time_s,energy_J,label"));
+    let mut points = 0;
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let key = match f[0] {
+            "kinetic" => "kinetic_energy",
+            "strain" => "strain_energy",
+            "external work" => "external_work",
+            "dissipated" => "dissipated",
+            "total" => "total_energy",
+            other => panic!("unexpected series {other}"),
+        };
+        let t: f64 = f[1].parse().unwrap();
+        let e: f64 = f[2].parse().unwrap();
+        let k = times.iter().position(|&s| s == t).expect("a stored time");
+        let expected = steps[k][key].as_f64().unwrap();
+        assert!(
+            (e - expected).abs() <= 1e-12 * expected.abs().max(1e-300),
+            "{key} at {t}: {e} against {expected}"
+        );
+        points += 1;
+    }
+    assert_eq!(points, 5 * 6);
+    assert!(!folder.join("plots/contact_force_time.csv").exists());
+    // The ParaView collection plays at the stored times.
+    let pvd = std::fs::read_to_string(folder.join("vtk/falling.pvd")).unwrap();
+    let pvd_times: Vec<f64> = pvd
+        .split("timestep=\"")
+        .skip(1)
+        .map(|s| s[..s.find('"').unwrap()].parse().unwrap())
+        .collect();
+    assert_eq!(pvd_times, times);
+    // The GIF at real speed: 0.02 s per frame, the last held 2 s.
+    let file = std::fs::File::open(folder.join("anim.gif")).unwrap();
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::Indexed);
+    let mut decoder = options.read_info(file).unwrap();
+    let mut delays = Vec::new();
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        delays.push(frame.delay);
+    }
+    assert_eq!(delays, vec![2, 2, 2, 2, 2, 200]);
+    // The batch table's dynamic columns.
+    let table = std::fs::read_to_string(out.join("batch.csv")).unwrap();
+    let mut rows = table.lines().map(|l| l.split(',').collect::<Vec<_>>());
+    let header = rows.next().unwrap();
+    let row = rows.next().unwrap();
+    let cell = |name: &str| -> f64 {
+        let k = header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("no column {name}: {header:?}"));
+        row[k].parse().unwrap()
+    };
+    assert_eq!(cell("duration"), 0.1);
+    assert_eq!(cell("peak_contact_force"), 0.0);
+    let ke = steps[5]["kinetic_energy"].as_f64().unwrap();
+    assert!(
+        (cell("final_kinetic_energy") - ke).abs() <= 1e-12 * ke,
+        "{ke}"
+    );
+}

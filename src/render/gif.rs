@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 /// Seconds each frame shows, and the hold on the last frame (hundredths of a second).
 const FRAME_DELAY: u16 = 50;
-const LAST_FRAME_DELAY: u16 = 200;
+pub(crate) const LAST_FRAME_DELAY: u16 = 200;
 
 /// Bits per channel of the colour look-up table (32³ cells).
 const LUT_BITS: u32 = 5;
@@ -184,8 +184,14 @@ impl GifAnimation {
 
     /// Append an encoded frame; `last` holds it longer.
     pub fn push_encoded(&mut self, frame: EncodedFrame, last: bool) -> Result<(), RenderError> {
+        self.push_encoded_for(frame, if last { LAST_FRAME_DELAY } else { FRAME_DELAY })
+    }
+
+    /// Append an encoded frame shown for `delay` hundredths of a second (a dynamic run's
+    /// real time to the next frame, see [`crate::render::timed_delays`]).
+    pub fn push_encoded_for(&mut self, frame: EncodedFrame, delay: u16) -> Result<(), RenderError> {
         let mut f = frame.0;
-        f.delay = if last { LAST_FRAME_DELAY } else { FRAME_DELAY };
+        f.delay = delay;
         self.encoder
             .write_lzw_pre_encoded_frame(&f)
             .map_err(encode_error)?;

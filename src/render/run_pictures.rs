@@ -1,10 +1,11 @@
 //! The pictures of a whole run: PNG frames and the GIF of its stored steps, drawn from its
 //! results in memory (during `linkage run`) or read back from a results folder (`linkage render`).
 
+use crate::render::gif::LAST_FRAME_DELAY;
 use crate::render::gltf::write_gltf;
 use crate::render::{
-    draw_frame, stored_time, Frame, GifAnimation, RenderError, RenderOptions, RunExtent,
-    StepSelection,
+    draw_frame, stored_time, timed_delays, Frame, GifAnimation, RenderError, RenderOptions,
+    RunExtent, StepSelection,
 };
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::publish::{publish_keeping, remove_stale, staging_dir};
@@ -24,6 +25,10 @@ pub struct RenderReport {
     pub gif: Option<PathBuf>,
     /// Displacement magnification used.
     pub magnification: f64,
+    /// A dynamic run's GIF plays at its stored times slowed down this many times (1: real
+    /// time; see [`crate::render::timed_delays`]); `None` for a quasi-static run or without
+    /// GIF (fixed 0.5 s per frame).
+    pub gif_slowdown: Option<f64>,
 }
 
 /// The stored steps `selection` picks from `run`.
@@ -203,6 +208,17 @@ fn draw_frames(
     } else {
         None
     };
+    // A dynamic run's frames show for their real time to the next (or a stated slow-down).
+    let timing = if gif.is_some() {
+        let times: Option<Vec<f64>> = steps
+            .iter()
+            .map(|&k| run.step(k).and_then(stored_time))
+            .collect();
+        times.and_then(|t| timed_delays(&t, LAST_FRAME_DELAY))
+    } else {
+        None
+    };
+    report.gif_slowdown = timing.as_ref().map(|(_, s)| *s);
     let batch = (2 * rayon::current_num_threads()).max(4);
     let mut gif = gif;
     for (b, chunk) in steps.chunks(batch).enumerate() {
@@ -235,7 +251,11 @@ fn draw_frames(
                 report.frames.push(final_png.join(name));
             }
             if let (Some(g), Some(e)) = (gif.as_mut(), encoded) {
-                g.push_encoded(e, b * batch + i + 1 == steps.len())?;
+                let index = b * batch + i;
+                match &timing {
+                    Some((delays, _)) => g.push_encoded_for(e, delays[index])?,
+                    None => g.push_encoded(e, index + 1 == steps.len())?,
+                }
             }
         }
     }

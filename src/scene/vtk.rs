@@ -64,9 +64,9 @@ pub enum VtkError {
 /// Write `dir/vtk/NNNN.vtu` for every stored step of `run` and `dir/vtk/<scene>.pvd`, and
 /// with obstacles `dir/vtk/obstacles_NNNN.vtu` (part 1 of the collection; `NNNN` padded to
 /// [`RunResults::digits`], as the step files are named); `dir` is the
-/// results folder (`DIR/<scene>`). The collection's `timestep` is the load factor when it
-/// grows strictly over the stored steps, else the step number (ParaView needs increasing
-/// times). Returns the files written.
+/// results folder (`DIR/<scene>`). The collection's `timestep` is a dynamic scene's time (s)
+/// of each stored state; else the load factor when it grows strictly over the stored steps,
+/// else the step number (ParaView needs increasing times). Returns the files written.
 ///
 /// The files are written into a staging folder that then replaces `vtk/` as a whole, so `vtk/`
 /// never holds files of an older run beside these (a user's other files in it, not `.vtu` or
@@ -140,7 +140,7 @@ fn write_vtk_into(
             },
         )?;
         written.push(path);
-        entries.push((step, result.load_factor, name));
+        entries.push((step, result.load_factor, result.time, name));
     }
     let mut obstacle_files = Vec::new();
     if !run.model.obstacles.is_empty() {
@@ -164,11 +164,17 @@ fn write_vtk_into(
         }
     }
     let increasing = entries.windows(2).all(|w| w[1].1 > w[0].1);
+    // A dynamic scene's states carry their time (s): the collection plays in real time.
+    let timed = entries.iter().all(|e| e.2.is_some());
     let mut pvd = String::from(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
     );
-    for (k, (step, factor, name)) in entries.iter().enumerate() {
-        let time = if increasing { *factor } else { *step as Real };
+    for (k, (step, factor, t, name)) in entries.iter().enumerate() {
+        let time = match t {
+            Some(t) if timed => *t,
+            _ if increasing => *factor,
+            _ => *step as Real,
+        };
         let _ = writeln!(
             pvd,
             "    <DataSet timestep=\"{time}\" group=\"\" part=\"0\" file=\"{name}\"/>"

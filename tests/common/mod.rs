@@ -46,16 +46,32 @@ force = [0.0, {}]
 /// (`.ci/run` installs it first); the error says why it cannot be made here.
 #[allow(dead_code)] // not every test binary reads with Python
 pub fn python_with_meshio() -> Result<PathBuf, String> {
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/meshio-venv");
+    python_with("meshio-venv", "meshio, numpy", "meshio")
+}
+
+/// A Python with openseespy (OpenSees in its wheel): `target/opensees-venv`, created and filled
+/// when missing (`.ci/run` installs it first); the error says why it cannot be made here.
+#[allow(dead_code)] // not every test binary runs OpenSees
+pub fn python_with_openseespy() -> Result<PathBuf, String> {
+    python_with("opensees-venv", "openseespy.opensees", "openseespy")
+}
+
+/// The Python of the venv `target/<venv>` where `import <imports>` works, made with
+/// `pip install <package>` from PyPI when missing.
+#[allow(dead_code)]
+fn python_with(venv: &str, imports: &str, package: &str) -> Result<PathBuf, String> {
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("target")
+        .join(venv);
     let python = venv.join("bin/python");
-    let has_meshio = |py: &Path| {
+    let has = |py: &Path| {
         Command::new(py)
-            .args(["-c", "import meshio, numpy"])
+            .args(["-c", &format!("import {imports}")])
             .output()
             .map(|o| o.status.success())
             .unwrap_or(false)
     };
-    if has_meshio(&python) {
+    if has(&python) {
         return Ok(python);
     }
     let made = Command::new("python3")
@@ -72,15 +88,15 @@ pub fn python_with_meshio() -> Result<PathBuf, String> {
         ));
     }
     let pip = Command::new(&python)
-        .args(["-m", "pip", "install", "--quiet", "meshio"])
+        .args(["-m", "pip", "install", "--quiet", package])
         .output()
         .map_err(|e| format!("cannot run the venv's python: {e}"))?;
-    if pip.status.success() && has_meshio(&python) {
+    if pip.status.success() && has(&python) {
         Ok(python)
     } else {
         Err(format!(
-            "cannot install meshio from PyPI into {}: {}\n\
-             check the network, or install it yourself: {} -m pip install meshio",
+            "cannot install {package} from PyPI into {} (or import {imports} from it): {}\n\
+             check the network, or install it yourself: {} -m pip install {package}",
             venv.display(),
             String::from_utf8_lossy(&pip.stderr),
             python.display()

@@ -1,7 +1,8 @@
 //! Every plot of one run, written to `plots/` of its results folder.
 
 use crate::render::plots::{
-    breaks, contact_forces, load_displacement, reaction, residuals, PlotError, WrittenPlot,
+    breaks, contact_force_time, contact_forces, energies, load_displacement, reaction, residuals,
+    PlotError, WrittenPlot,
 };
 use crate::scene::{PlotSettings, RunResults, Summary};
 use std::path::Path;
@@ -12,7 +13,8 @@ pub const PLOTS: &str = "plots";
 /// Write the plots of the run with `summary` and stored steps `run` into `dir/plots/`: always
 /// the load–displacement curve (and with `settings.node` the reaction total); the contact
 /// forces when a pair touched, the Newton residuals when a step was nonlinear, the breaks when
-/// members broke. Each as PNG, SVG and the CSV of its points, written atomically.
+/// members broke; for a dynamic scene the energies against time, and the total contact force
+/// against time when something touched. Each as PNG, SVG and the CSV of its points, written atomically.
 pub fn plot_run(
     summary: &Summary,
     run: &RunResults,
@@ -31,5 +33,7 @@ pub fn plot_run(
     charts.extend(contact_forces(summary));
     charts.extend(residuals(summary));
     charts.extend(breaks(summary));
+    charts.extend(energies(summary));
+    charts.extend(contact_force_time(summary));
     charts.iter().map(|c| c.write(&plots)).collect()
 }

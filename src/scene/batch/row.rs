@@ -2,7 +2,7 @@
 //! because its results are there gets the same row as the run that wrote them).
 
 use crate::scene::batch::jobs::Job;
-use crate::scene::batch::table::{contact_column, Row};
+use crate::scene::batch::table::{contact_column, Row, DYNAMIC};
 use crate::scene::peak_stress::peak_stress;
 use crate::scene::{StoredRun, Summary, World};
 use crate::Real;
@@ -74,6 +74,28 @@ pub fn job_row(job: &Job, status: String, results: Option<&Path>, world: Option<
                 ));
             }
         }
+    }
+    let states: Vec<_> = summary
+        .steps
+        .iter()
+        .filter_map(|s| s.dynamics.as_ref().map(|d| (s, d)))
+        .collect();
+    if let Some((_, last)) = states.last() {
+        let peak_contact = states
+            .iter()
+            .map(|(s, _)| {
+                s.contact_forces
+                    .iter()
+                    .map(|p| p.force.iter().map(|f| f * f).sum::<Real>().sqrt())
+                    .fold(0.0, Real::max)
+            })
+            .fold(0.0, Real::max);
+        let values = [last.time, peak_contact, last.kinetic_energy];
+        row.dynamics = DYNAMIC
+            .iter()
+            .zip(values)
+            .map(|(name, v)| (name.to_string(), format!("{v:e}")))
+            .collect();
     }
     let residual = summary
         .steps

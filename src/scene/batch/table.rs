@@ -45,6 +45,10 @@ pub struct Row {
     pub broken: String,
     /// Total contact force per pair at the last step: (`contact_force.<body>.<with>.<x|y|z>`, N).
     pub contact: Vec<(String, String)>,
+    /// A dynamic scene's [`DYNAMIC`] columns (name, value): `duration` (s, the simulated time
+    /// reached), `peak_contact_force` (N, the largest magnitude of a pair's total contact force over
+    /// the stored states, 0 without contact) and `final_kinetic_energy` (J); empty for a static scene.
+    pub dynamics: Vec<(String, String)>,
     /// Largest relative residual over the steps.
     pub residual: String,
     /// Every warning of the run, `; `-separated.
@@ -66,6 +70,9 @@ const MIDDLE: [&str; 11] = [
     "residual",
 ];
 const TAIL: [&str; 1] = ["warnings"];
+/// The columns of a dynamic scene, after the contact pairs; in the table only when a row has
+/// them.
+pub(crate) const DYNAMIC: [&str; 3] = ["duration", "peak_contact_force", "final_kinetic_energy"];
 
 impl Row {
     fn fixed(&self) -> [&String; 15] {
@@ -128,15 +135,18 @@ fn cell<'a>(list: &'a [(String, String)], name: &str) -> &'a str {
         .map_or("", |(_, v)| v.as_str())
 }
 
-/// The table of `rows`, in their order: the fixed columns, the swept keys after `variant` and
-/// the contact pairs after `broken`, each in order of first appearance.
+/// The table of `rows`, in their order: the fixed columns, the swept keys after `variant`,
+/// the contact pairs after `broken` and then a dynamic scene's [`DYNAMIC`] columns, each in
+/// order of first appearance.
 pub fn table_csv(rows: &[Row]) -> String {
     let swept = union(rows.iter().map(|r| &r.values));
     let pairs = union(rows.iter().map(|r| &r.contact));
+    let dynamic = union(rows.iter().map(|r| &r.dynamics));
     let mut header: Vec<String> = HEAD.iter().map(|s| s.to_string()).collect();
     header.extend(swept.iter().cloned());
     header.extend(MIDDLE[..10].iter().map(|s| s.to_string()));
     header.extend(pairs.iter().cloned());
+    header.extend(dynamic.iter().cloned());
     header.push(MIDDLE[10].to_string());
     header.extend(TAIL.iter().map(|s| s.to_string()));
     let mut text = record(&header);
@@ -146,6 +156,7 @@ pub fn table_csv(rows: &[Row]) -> String {
         line.extend(swept.iter().map(|k| cell(&r.values, k)));
         line.extend(f[3..13].iter().map(|s| s.as_str()));
         line.extend(pairs.iter().map(|k| cell(&r.contact, k)));
+        line.extend(dynamic.iter().map(|k| cell(&r.dynamics, k)));
         line.extend(f[13..].iter().map(|s| s.as_str()));
         text.push_str(&record(&line));
     }
@@ -189,6 +200,8 @@ pub fn parse_table(text: &str) -> Result<Vec<Row>, String> {
                 continue;
             } else if name.starts_with(CONTACT) {
                 row.contact.push((name.clone(), value));
+            } else if DYNAMIC.contains(&name.as_str()) {
+                row.dynamics.push((name.clone(), value));
             } else {
                 row.values.push((name.clone(), value));
             }
