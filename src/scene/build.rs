@@ -312,7 +312,6 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
                 message,
             }
         })?;
-        let mut body = body;
         add_self_weight(&mut body, &spec, &density, dynamics.is_some()).map_err(|e| at(0..0, e))?;
         if let Some(d) = dynamics.as_mut() {
             d.bodies.push(body_start(b, &body, &spec, &density, &at)?);
