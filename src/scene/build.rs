@@ -337,7 +337,6 @@ fn build_world_from(
                 message,
             }
         })?;
-        let mut body = body;
         add_self_weight(&mut body, &spec, &density, dynamics.is_some()).map_err(|e| at(0..0, e))?;
         if let Some(d) = dynamics.as_mut() {
             d.bodies.push(body_start(b, &body, &spec, &density, &at)?);

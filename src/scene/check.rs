@@ -157,30 +157,6 @@ pub fn output_warning(world: &World) -> Option<String> {
     ))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn stored_steps_count_step_zero_and_the_last() {
-        let every = |every, last_only| OutputSettings {
-            every,
-            last_only,
-            ..OutputSettings::default()
-        };
-        assert_eq!(stored_steps(&every(1, false), 10), 11);
-        assert_eq!(stored_steps(&every(3, false), 10), 5); // 0, 3, 6, 9, 10
-        assert_eq!(stored_steps(&every(5, false), 10), 3); // 0, 5, 10
-        assert_eq!(stored_steps(&every(1, true), 10), 2);
-        assert_eq!(stored_steps(&every(1, true), 0), 1);
-        for (e, last_only, steps) in [(3, false, 10), (4, false, 7), (1, true, 5), (2, false, 1)] {
-            let o = every(e, last_only);
-            let counted = (0..=steps).filter(|&s| o.writes(s, steps)).count() as u64;
-            assert_eq!(stored_steps(&o, steps), counted);
-        }
-    }
-}
-
 /// Bodies with more members than this are not homogenized by `linkage check` (the three
 /// uniaxial tests factor the body three times).
 pub const SOLID_CHECK_MEMBERS: usize = 300_000;
@@ -233,4 +209,28 @@ fn is_closed(patches: &[[usize; 3]]) -> bool {
         }
     }
     !patches.is_empty() && edges.values().all(|&n| n == 2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stored_steps_count_step_zero_and_the_last() {
+        let every = |every, last_only| OutputSettings {
+            every,
+            last_only,
+            ..OutputSettings::default()
+        };
+        assert_eq!(stored_steps(&every(1, false), 10), 11);
+        assert_eq!(stored_steps(&every(3, false), 10), 5); // 0, 3, 6, 9, 10
+        assert_eq!(stored_steps(&every(5, false), 10), 3); // 0, 5, 10
+        assert_eq!(stored_steps(&every(1, true), 10), 2);
+        assert_eq!(stored_steps(&every(1, true), 0), 1);
+        for (e, last_only, steps) in [(3, false, 10), (4, false, 7), (1, true, 5), (2, false, 1)] {
+            let o = every(e, last_only);
+            let counted = (0..=steps).filter(|&s| o.writes(s, steps)).count() as u64;
+            assert_eq!(stored_steps(&o, steps), counted);
+        }
+    }
 }

@@ -118,9 +118,9 @@ pub fn effective_elasticity(
         .collect();
     let mut moduli = [0.0; 3];
     let mut ratios = Vec::with_capacity(6);
-    for d in 0..3 {
+    for (d, modulus) in moduli.iter_mut().enumerate() {
         let test = uniaxial_test(body, &stiffness, d)?;
-        moduli[d] = test.force * test.length / volume;
+        *modulus = test.force * test.length / volume;
         for j in (0..3).filter(|&j| j != d) {
             ratios.push(-test.gradient[j]);
         }
@@ -157,7 +157,7 @@ fn uniaxial_test(body: &Body, stiffness: &[Real], d: usize) -> Result<Uniaxial, 
     let (lo, hi) = bounds(body);
     let length = hi[d] - lo[d];
     let tolerance = 1e-6 * body.size();
-    if !(length > tolerance) {
+    if length.is_nan() || length <= tolerance {
         return Err(HomogenizeError::NotSolid {
             body: body.name.clone(),
             why: format!("it is flat along {}", AXES[d]),
