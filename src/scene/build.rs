@@ -211,8 +211,11 @@ pub fn build_world_with(text: &str, path: &Path, files: &InlineFiles) -> Result<
             )
         })?),
     };
-    let pictures =
+    let mut pictures =
         PictureSettings::from_spec(&spec.output).map_err(|e| at(output_span.clone(), e))?;
+    if let Some(g) = &spec.gravity {
+        pictures.up_against(g);
+    }
 
     let mut materials = Vec::new();
     for m in &spec.materials {
