@@ -22,6 +22,7 @@ fn square() -> (ModelFile, StepResult) {
     let model = ModelFile {
         scene: "square".into(),
         obstacles: Vec::new(),
+        up: None,
         bodies: vec![ModelBody {
             name: "b".into(),
             dimension: 2,
@@ -163,6 +164,7 @@ fn two_patches() -> (ModelFile, StepResult) {
     let model = ModelFile {
         scene: "lit".into(),
         obstacles: Vec::new(),
+        up: None,
         bodies: vec![ModelBody {
             name: "p".into(),
             dimension: 3,

@@ -30,6 +30,7 @@ pub fn bent_shell(rings: usize, sectors: usize) -> Result<(ModelFile, Vec<StepRe
     let model = ModelFile {
         scene: "bench_shell".to_string(),
         obstacles: Vec::new(),
+        up: None,
         bodies: vec![ModelBody {
             name: "shell".to_string(),
             dimension: 3,

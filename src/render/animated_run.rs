@@ -449,6 +449,7 @@ mod tests {
                 strengths: vec![],
             }],
             obstacles: vec![],
+            up: None,
         };
         let steps = (0..n)
             .map(|k| {

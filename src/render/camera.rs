@@ -4,14 +4,19 @@ use crate::render::Projection;
 use crate::Real;
 use nalgebra::Vector3;
 
-/// Where the camera looks from: angles in degrees around the centre of what it shows, +y up.
-/// Azimuth 0 and elevation 0 look along −z (the plane of 2D bodies face on).
+/// Where the camera looks from: angles in degrees around the centre of what it shows, about
+/// the scene's `up` direction. With `up` = +y, azimuth 0 and elevation 0 look along −z (the
+/// plane of 2D bodies face on); another `up` turns the whole view by the rotation that takes
+/// +y to it (with +z up, azimuth 0 looks along +y, x to the right).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
-    /// Rotation about +y, degrees, from +z towards +x.
+    /// Rotation about `up`, degrees (with +y up: from +z towards +x).
     pub azimuth: Real,
-    /// Angle above the x–z plane, degrees (−90 to 90).
+    /// Angle above the plane normal to `up`, degrees (−90 to 90).
     pub elevation: Real,
+    /// The unit direction drawn upwards on the frame (+y for most scenes, +z for z-up
+    /// scenes, opposite gravity when a scene has it).
+    pub up: Vector3<Real>,
     /// Magnification of the fitted view (1: the box fills the viewport).
     pub zoom: Real,
     /// Orthographic or perspective.
@@ -50,6 +55,9 @@ impl Camera {
         } else {
             Vector3::y()
         };
+        // The y-up view turned so that +y goes to `self.up`.
+        let turn = turn_y_to(&self.up);
+        let (back, world_up) = (turn * back, turn * world_up);
         let right = world_up.cross(&back).normalize();
         let up = back.cross(&right);
         let centre = (min + max) / 2.0;
@@ -95,6 +103,17 @@ impl Camera {
         };
         view
     }
+}
+
+/// The rotation that takes +y to the direction `up` (the identity for +y or a zero vector;
+/// half a turn about +x for −y): x stays to the right when `up` lies in the x = 0 plane.
+pub fn turn_y_to(up: &Vector3<Real>) -> nalgebra::Rotation3<Real> {
+    let Some(u) = up.try_normalize(1e-12) else {
+        return nalgebra::Rotation3::identity();
+    };
+    nalgebra::Rotation3::rotation_between(&Vector3::y(), &u).unwrap_or_else(|| {
+        nalgebra::Rotation3::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
+    })
 }
 
 impl View {
@@ -153,6 +172,7 @@ mod tests {
             elevation: 0.0,
             zoom: 1.0,
             projection: Projection::Orthographic,
+            up: Vector3::y(),
         };
         let v = cam.fit(
             Vector3::new(0.0, 0.0, 0.0),
@@ -172,6 +192,7 @@ mod tests {
             elevation: 20.0,
             zoom: 1.0,
             projection: Projection::Perspective,
+            up: Vector3::y(),
         };
         let v = cam.fit(
             Vector3::new(-1.0, -1.0, -1.0),
@@ -182,5 +203,38 @@ mod tests {
         let near = v.project(&(back * 0.9));
         let far = v.project(&(-back * 0.9));
         assert!(near[2] < far[2]);
+    }
+
+    #[test]
+    fn z_up_draws_z_upwards_and_keeps_x_to_the_right() {
+        let cam = Camera {
+            azimuth: 0.0,
+            elevation: 0.0,
+            zoom: 1.0,
+            projection: Projection::Orthographic,
+            up: Vector3::z(),
+        };
+        let v = cam.fit(
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(1.0, 1.0, 1.0),
+            [0.0, 0.0, 100.0, 100.0],
+        );
+        let o = v.project(&Vector3::zeros());
+        let z = v.project(&Vector3::z());
+        let x = v.project(&Vector3::x());
+        // Pixel y grows downwards: +z is above the origin by the whole viewport, +x right.
+        assert!((o[1] - z[1] - 100.0).abs() < 1e-3, "{o:?} {z:?}");
+        assert!((x[0] - o[0] - 100.0).abs() < 1e-3, "{o:?} {x:?}");
+        // Seen along +y (azimuth 0 turned with the scene): a step along y changes only depth.
+        let y = v.project(&Vector3::y());
+        assert!((y[0] - o[0]).abs() < 1e-3 && (y[1] - o[1]).abs() < 1e-3);
+    }
+
+    #[test]
+    fn up_turns_y_to_the_given_axis() {
+        for up in [Vector3::x(), Vector3::y(), Vector3::z(), -Vector3::y()] {
+            let t = turn_y_to(&up);
+            assert!((t * Vector3::y() - up).norm() < 1e-12, "{up:?}");
+        }
     }
 }

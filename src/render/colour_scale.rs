@@ -58,6 +58,19 @@ pub const SUPPORT_TEAL: Rgb = Rgb::bytes(0, 112, 120);
 pub const INK: Rgb = Rgb::bytes(30, 30, 34);
 /// Members and surfaces with `Colouring::Plain`.
 pub const PLAIN: Rgb = Rgb::bytes(96, 104, 118);
+/// The mark of a broken member (a crack): brighter than the red end of the stress scale.
+pub const CRACK_RED: Rgb = Rgb::bytes(240, 0, 0);
+/// Each body's own colour (outline under its members, silhouette of its surface), by body
+/// index in turn, so bodies pressed together read as separate; drawn only when a frame has
+/// more than one body. Chosen apart from the stress scale, obstacles and arrows.
+pub const BODY_COLOURS: [Rgb; 6] = [
+    Rgb::bytes(120, 200, 140),
+    Rgb::bytes(190, 150, 230),
+    Rgb::bytes(240, 200, 80),
+    Rgb::bytes(110, 200, 220),
+    Rgb::bytes(230, 150, 190),
+    Rgb::bytes(170, 170, 90),
+];
 /// Surfaces with `Colouring::Plain`.
 pub const PLAIN_SURFACE: Rgb = Rgb::bytes(178, 190, 208);
 

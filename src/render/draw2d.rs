@@ -1,8 +1,10 @@
 //! 2D bodies as line art: members coloured by stress, overloaded members black, the undeformed ghost.
 
 use crate::render::colour_scale::{ColourScale, BLACK, GHOST_GREY, PLAIN};
+use crate::render::cracks::crack_marks;
 use crate::render::deformed_body::DeformedBody;
-use crate::render::{Colouring, Layer, Primitive, View};
+use crate::render::outline::member_band;
+use crate::render::{Colouring, Layer, Primitive, Rgb, View};
 use crate::Real;
 
 /// Line widths, pixels at 720 pixels of frame height: (member, overloaded member, ghost).
@@ -27,7 +29,9 @@ pub fn line_widths(body: &DeformedBody, view: &View, ui: f32) -> (f32, f32, f32)
 
 /// The members of a body as lines: the undeformed shape as a faint ghost behind, members
 /// coloured by axial stress (or plain), overloaded members black and thicker on top, as in
-/// the paper's Fig. 6; broken members are left out, so a crack shows as a gap. Used for 2D bodies and for 3D bodies without patches (then drawn
+/// the paper's Fig. 6; broken members are left out, so a crack shows as a gap, and marked
+/// by a short red line. `outline`: the body's own colour as a band under its members (frames
+/// of several bodies). Used for 2D bodies and for 3D bodies without patches (then drawn
 /// back to front).
 pub fn member_lines(
     body: &DeformedBody,
@@ -35,6 +39,7 @@ pub fn member_lines(
     colouring: Colouring,
     scale: &ColourScale,
     ui: f32,
+    outline: Option<Rgb>,
 ) -> Vec<Primitive> {
     let (width, heavy, ghost) = line_widths(body, view, ui);
     let members = &body.model.members;
@@ -59,6 +64,9 @@ pub fn member_lines(
                 depth_test: false,
             });
         }
+    }
+    if let Some(colour) = outline {
+        out.extend(member_band(body, colour, heavy * 2.5));
     }
     let stress = |j: usize| body.result.stresses.get(j).copied().unwrap_or(0.0) as Real;
     let line = |j: usize, colour, width| {
@@ -88,5 +96,6 @@ pub fn member_lines(
     for &j in order.iter().filter(intact).filter(|&&j| body.overloaded[j]) {
         out.push(line(j, BLACK, heavy));
     }
+    out.extend(crack_marks(body, heavy * 1.4, false));
     out
 }

@@ -1,9 +1,11 @@
 //! 3D bodies as shaded surfaces coloured by the mean stress of the members at each node.
 
 use crate::render::colour_scale::{ColourScale, BLACK, GHOST_GREY, PLAIN_SURFACE};
+use crate::render::cracks::crack_marks;
 use crate::render::deformed_body::DeformedBody;
 use crate::render::draw2d::line_widths;
-use crate::render::{Colouring, Layer, Mesh, Primitive, Rgb, View};
+use crate::render::outline::silhouette;
+use crate::render::{Colouring, Layer, Mesh, MeshKind, Primitive, Rgb, View};
 use crate::scene::ModelBody;
 use crate::Real;
 use nalgebra::Vector3;
@@ -106,7 +108,8 @@ pub fn corner_normals(
 /// stress at the nodes, or plain), the undeformed members as a faint ghost behind, optionally
 /// the members as a wireframe, and overloaded members as black lines on top (hidden where
 /// behind the surface). Broken members are left out, and so are the patches they border,
-/// so a crack shows as a gap.
+/// so a crack shows as a gap, and each is marked by a short red line where it is not hidden.
+/// `outline`: the body's own colour for its silhouette (frames of several bodies).
 pub fn shaded_surface(
     body: &DeformedBody,
     view: &View,
@@ -114,6 +117,7 @@ pub fn shaded_surface(
     node_scale: &ColourScale,
     wireframe: bool,
     ui: f32,
+    outline: Option<Rgb>,
 ) -> Vec<Primitive> {
     let model = body.model;
     let (width, heavy, ghost) = line_widths(body, view, ui);
@@ -160,11 +164,15 @@ pub fn shaded_surface(
             .collect(),
         Colouring::Plain => vec![PLAIN_SURFACE; body.positions.len()],
     };
+    let rim = outline
+        .map(|c| silhouette(body, &triangles, view, c, heavy))
+        .unwrap_or_default();
     out.push(Primitive::Surface(Mesh {
         normals: corner_normals(&body.positions, &triangles),
         positions: body.positions.clone(),
         colours,
         triangles,
+        kind: MeshKind::Body,
     }));
     let line = |j: usize, colour, alpha, width| {
         let m = members[j];
@@ -193,5 +201,7 @@ pub fn shaded_surface(
     {
         out.push(line(j, BLACK, 1.0, heavy));
     }
+    out.extend(rim);
+    out.extend(crack_marks(body, heavy * 1.4, true));
     out
 }

@@ -1,6 +1,7 @@
 //! What stays fixed over the frames of a run: the box the camera fits, the magnification, the
 //! arrow scales and the colour ranges.
 
+use crate::render::contact_magnification::contact_magnification;
 use crate::render::draw3d::{node_peak_stresses, node_stresses};
 use crate::render::obstacles::{bodies_diagonal, place_obstacle, HALF_SPACE_BAND};
 use crate::scene::{ModelFile, RunResults, StepResult};
@@ -31,8 +32,9 @@ pub struct RunExtent {
     /// draw equally long), m/N: the largest force gets 15% of `size`.
     pub force_scale: Real,
     /// Whether bodies touch obstacles or each other in this run (there are obstacles, several
-    /// bodies or contact forces): the automatic magnification is then 1, so that nothing is
-    /// drawn through what it touches.
+    /// bodies or contact forces): the automatic magnification is then the largest round
+    /// factor at which nothing is drawn through what it touches (1 for a body touching
+    /// itself), see [`contact_magnification`].
     pub contact: bool,
     /// Whether some contact of the run has a tangential (friction) force: its arrows and
     /// legend are drawn.
@@ -46,6 +48,8 @@ pub struct RunExtent {
     pub node_peak_limit: Real,
     /// The last stored step.
     pub last_step: usize,
+    /// The unit direction drawn upwards (the model's `up`, +y when it has none).
+    pub up: Vector3<Real>,
 }
 
 fn vec3(p: &[Real]) -> Vector3<Real> {
@@ -173,11 +177,18 @@ impl RunExtent {
                 }
             }
         }
+        // A body touching itself (pieces of a broken body) could be drawn through itself.
+        let self_contact = steps.iter().any(|r| {
+            r.bodies
+                .iter()
+                .any(|b| b.contacts.iter().any(|c| c.with == b.name))
+        });
         let magnification = magnification.unwrap_or_else(|| {
-            if touching {
-                1.0
-            } else {
-                auto_magnification(max_displacement, size)
+            let free = auto_magnification(max_displacement, size);
+            match (touching, self_contact) {
+                (false, _) => free,
+                (true, true) => 1.0,
+                (true, false) => contact_magnification(model, steps, free),
             }
         });
         let largest = max_force.max(max_contact);
@@ -238,6 +249,7 @@ impl RunExtent {
             node_stress_limit,
             node_peak_limit,
             last_step,
+            up: model.up.map_or_else(Vector3::y, |u| vec3(&u)),
         }
     }
 }

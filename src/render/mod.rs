@@ -7,9 +7,10 @@ pub use self::animated_run::{
 };
 pub use self::camera::{Camera, View, FIELD_OF_VIEW};
 pub use self::colour_scale::{
-    colour_at, format_si, ColourScale, Rgb, CONTACT_ORANGE, FORCE_BLUE, OBSTACLE_FILL,
-    OBSTACLE_SURFACE, SUPPORT_TEAL,
+    colour_at, format_si, ColourScale, Rgb, BODY_COLOURS, CONTACT_ORANGE, CRACK_RED, FORCE_BLUE,
+    OBSTACLE_FILL, OBSTACLE_SURFACE, SUPPORT_TEAL,
 };
+pub use self::contact_magnification::{contact_magnification, round_factors_down};
 pub use self::error::RenderError;
 pub use self::extent::{auto_magnification, RunExtent};
 pub use self::frame::Frame;
@@ -17,8 +18,8 @@ pub use self::gif::{EncodedFrame, GifAnimation, GifPalette};
 pub use self::gif_timing::timed_delays;
 pub use self::options::{Colouring, Projection, RenderOptions, StepSelection};
 pub use self::picture::{camera_for, draw_frame, frame_primitives, view_for, viewport_for};
-pub use self::primitives::{paint, Layer, Mesh, Primitive};
-pub use self::raster::{Lighting, RasterVertex, Rasteriser};
+pub use self::primitives::{paint, Layer, Mesh, MeshKind, Primitive};
+pub use self::raster::{Lighting, RasterVertex, Rasteriser, PLANE_ALPHA, VEIL_ALPHA};
 pub use self::run_pictures::{
     draw_run, render_run, render_run_to, select_steps, PictureWriter, RenderReport,
 };
@@ -26,6 +27,8 @@ pub use self::run_pictures::{
 mod animated_run;
 mod camera;
 mod colour_scale;
+mod contact_magnification;
+mod cracks;
 mod deformed_body;
 mod draw2d;
 mod draw3d;
@@ -38,6 +41,7 @@ pub mod gltf;
 mod markers;
 mod obstacles;
 mod options;
+mod outline;
 mod overlay;
 mod picture;
 pub mod plots;

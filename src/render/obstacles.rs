@@ -5,7 +5,7 @@
 
 use crate::render::colour_scale::{OBSTACLE_EDGE, OBSTACLE_FILL, OBSTACLE_SURFACE};
 use crate::render::draw3d::corner_normals;
-use crate::render::{Mesh, Primitive, View};
+use crate::render::{Mesh, MeshKind, Primitive, View};
 use crate::scene::{ModelFile, ModelObstacle, HALF_SPACE_PATCH};
 use crate::Real;
 use nalgebra::Vector3;
@@ -201,8 +201,9 @@ impl PlacedObstacle {
     }
 
     /// The surface as a shaded mesh in the obstacle colour, only the triangles facing the
-    /// camera of `view` (a closed obstacle loses nothing; a half-space seen from inside, a
-    /// press above the bodies, is not drawn, so it does not hide them).
+    /// camera of `view` (a closed obstacle loses nothing), see-through where a body lies
+    /// behind it ([`MeshKind::Obstacle`]); a half-space seen from inside (a press above the
+    /// bodies) as a see-through plane ([`MeshKind::Plane`]), so it does not hide them.
     pub fn mesh(&self, view: &View) -> Mesh {
         let front: Vec<[usize; 3]> = self
             .triangles
@@ -217,11 +218,23 @@ impl PlacedObstacle {
                 (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) < 0.0
             })
             .collect();
+        let (triangles, kind) = if front.is_empty() && self.half_space.is_some() {
+            let all: Vec<[usize; 3]> = self
+                .triangles
+                .iter()
+                .copied()
+                .filter(|t| t.iter().all(|&k| k < self.vertices.len()))
+                .collect();
+            (all, MeshKind::Plane)
+        } else {
+            (front, MeshKind::Obstacle)
+        };
         Mesh {
-            normals: corner_normals(&self.vertices, &front),
+            normals: corner_normals(&self.vertices, &triangles),
             positions: self.vertices.clone(),
             colours: vec![OBSTACLE_SURFACE; self.vertices.len()],
-            triangles: front,
+            triangles,
+            kind,
         }
     }
 }

@@ -6,6 +6,7 @@ use crate::render::draw2d::member_lines;
 use crate::render::draw3d::shaded_surface;
 use crate::render::markers::markers;
 use crate::render::obstacles::obstacle_primitives;
+use crate::render::outline::body_colour;
 use crate::render::overlay::{draw_overlay, Caption, Layout};
 use crate::render::{
     paint, Camera, Colouring, Frame, Lighting, Primitive, Projection, RenderError, RenderOptions,
@@ -27,6 +28,7 @@ pub fn camera_for(options: &RenderOptions, extent: &RunExtent) -> Camera {
         elevation: options.elevation.unwrap_or(el),
         zoom: options.zoom,
         projection: options.projection.unwrap_or(projection),
+        up: extent.up,
     }
 }
 
@@ -91,8 +93,10 @@ fn collect_frame(
         peak: None,
         surfaces: false,
     };
-    for (m, r) in model.bodies.iter().zip(&step.bodies) {
+    let several = model.bodies.len() > 1;
+    for (index, (m, r)) in model.bodies.iter().zip(&step.bodies).enumerate() {
         let body = DeformedBody::new(m, r, extent.magnification);
+        let outline = several.then(|| body_colour(index));
         for u in &r.displacements {
             facts.max_displacement = facts
                 .max_displacement
@@ -118,6 +122,7 @@ fn collect_frame(
                 &node_scale,
                 options.wireframe,
                 layout.ui,
+                outline,
             ));
         } else {
             primitives.extend(member_lines(
@@ -126,6 +131,7 @@ fn collect_frame(
                 options.colouring,
                 &member_scale,
                 layout.ui,
+                outline,
             ));
         }
         primitives.extend(markers(&body, extent, shaded));

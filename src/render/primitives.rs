@@ -26,6 +26,23 @@ pub struct Mesh {
     pub colours: Vec<Rgb>,
     /// Triangles.
     pub triangles: Vec<[usize; 3]>,
+    /// How it covers what is behind it.
+    pub kind: MeshKind,
+}
+
+/// How a shaded mesh covers what lies behind it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MeshKind {
+    /// Opaque (a body's surface): drawn first.
+    #[default]
+    Body,
+    /// Opaque over the background and other obstacles, see-through
+    /// ([`crate::render::raster::VEIL_ALPHA`]) where a body lies behind it, so it never hides
+    /// one (a rigid obstacle).
+    Obstacle,
+    /// See-through everywhere ([`crate::render::raster::PLANE_ALPHA`]): a half-space seen
+    /// from inside, whose plane would otherwise cover the bodies.
+    Plane,
 }
 
 /// Something to draw, in world coordinates (m); sizes on the frame in pixels at 720 pixels
@@ -129,9 +146,14 @@ pub fn paint(
         .any(|p| matches!(p, Primitive::Surface(_)))
     {
         let mut r = Rasteriser::new(frame.width() as usize * ss, frame.height() as usize * ss);
-        for p in primitives {
-            if let Primitive::Surface(mesh) = p {
-                rasterise_mesh(&mut r, view, ss as f32, mesh, lighting);
+        // Bodies first, so obstacles in front of them know to let them show through.
+        for kind in [MeshKind::Body, MeshKind::Obstacle, MeshKind::Plane] {
+            for p in primitives {
+                if let Primitive::Surface(mesh) = p {
+                    if mesh.kind == kind {
+                        rasterise_mesh(&mut r, view, ss as f32, mesh, lighting);
+                    }
+                }
             }
         }
         let bytes = r.resolve(ss);
@@ -246,7 +268,7 @@ fn rasterise_mesh(r: &mut Rasteriser, view: &View, ss: f32, mesh: &Mesh, lightin
                 colour: [c.0, c.1, c.2],
             }
         };
-        r.triangle(&[vertex(0), vertex(1), vertex(2)], lighting);
+        r.triangle_of(&[vertex(0), vertex(1), vertex(2)], lighting, mesh.kind);
     }
 }
 

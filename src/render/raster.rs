@@ -1,5 +1,7 @@
 //! The software rasteriser of shaded triangles: lighting and a depth buffer.
 
+use crate::render::primitives::MeshKind;
+
 /// Light for the shaded surfaces, in camera axes (x right, y up, z towards the viewer).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lighting {
@@ -47,7 +49,15 @@ pub struct Rasteriser {
     depth: Vec<f32>,
     /// Packed 0xAABBGGRR; alpha 0 where nothing was drawn.
     colour: Vec<u32>,
+    /// Whether the nearest opaque thing at each pixel is a body ([`MeshKind::Body`]).
+    body: Vec<bool>,
 }
+
+/// Opacity of an obstacle where a body lies behind it.
+pub const VEIL_ALPHA: f32 = 0.3;
+
+/// Opacity of a half-space's plane seen from inside.
+pub const PLANE_ALPHA: f32 = 0.22;
 
 impl Rasteriser {
     /// An empty raster of `width` × `height` pixels.
@@ -57,6 +67,7 @@ impl Rasteriser {
             height,
             depth: vec![f32::INFINITY; width * height],
             colour: vec![0; width * height],
+            body: vec![false; width * height],
         }
     }
 
@@ -87,8 +98,16 @@ impl Rasteriser {
         self.colour[y * self.width + x].to_le_bytes()
     }
 
-    /// Draw one triangle: every pixel whose centre is inside and nearer than what is there.
+    /// Draw one opaque triangle of a body: every pixel whose centre is inside and nearer than
+    /// what is there.
     pub fn triangle(&mut self, v: &[RasterVertex; 3], light: &Lighting) {
+        self.triangle_of(v, light, MeshKind::Body)
+    }
+
+    /// Draw one triangle of a mesh of `kind`: every pixel whose centre is inside and nearer
+    /// than what is there, opaque or blended over it as `kind` says (see-through parts leave
+    /// the depth of what they cover).
+    pub fn triangle_of(&mut self, v: &[RasterVertex; 3], light: &Lighting, kind: MeshKind) {
         let [p0, p1, p2] = [v[0].position, v[1].position, v[2].position];
         let area = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p2[0] - p0[0]) * (p1[1] - p0[1]);
         if area.abs() < 1e-12 || !area.is_finite() {
@@ -148,7 +167,16 @@ impl Rasteriser {
                     let z = w0 * z0 + w1 * z1 + w2 * z2;
                     let i = row + x;
                     if z < self.depth[i] {
-                        self.depth[i] = z;
+                        let alpha = match kind {
+                            MeshKind::Body => 1.0,
+                            MeshKind::Obstacle if self.body[i] => VEIL_ALPHA,
+                            MeshKind::Obstacle => 1.0,
+                            MeshKind::Plane => PLANE_ALPHA,
+                        };
+                        if alpha >= 1.0 {
+                            self.depth[i] = z;
+                            self.body[i] = kind == MeshKind::Body;
+                        }
                         let mut nx = w0 * n0[0] + w1 * n1[0] + w2 * n2[0];
                         let mut ny = w0 * n0[1] + w1 * n1[1] + w2 * n2[1];
                         let mut nz = w0 * n0[2] + w1 * n1[2] + w2 * n2[2];
@@ -172,7 +200,17 @@ impl Rasteriser {
                             let base = w0 * c0[k] + w1 * c1[k] + w2 * c2[k];
                             ((base * lit + spec).clamp(0.0, 1.0) * 255.0 + 0.5) as u32
                         };
-                        self.colour[i] = ch(0) | (ch(1) << 8) | (ch(2) << 16) | (255 << 24);
+                        let mut rgb = [ch(0), ch(1), ch(2)];
+                        if alpha < 1.0 {
+                            // Over what is there, or over the white background.
+                            let under = self.colour[i].to_le_bytes();
+                            let white = under[3] == 0;
+                            for (k, c) in rgb.iter_mut().enumerate() {
+                                let u = if white { 255.0 } else { under[k] as f32 };
+                                *c = (alpha * *c as f32 + (1.0 - alpha) * u + 0.5) as u32;
+                            }
+                        }
+                        self.colour[i] = rgb[0] | (rgb[1] << 8) | (rgb[2] << 16) | (255 << 24);
                     }
                 }
                 w0 += e0.0;

@@ -230,8 +230,11 @@ fn build_world_from(
             )
         })?),
     };
-    let pictures =
+    let mut pictures =
         PictureSettings::from_spec(&spec.output).map_err(|e| at(output_span.clone(), e))?;
+    if let Some(g) = &spec.gravity {
+        pictures.up_against(g);
+    }
 
     let mut materials = Vec::new();
     for m in &spec.materials {

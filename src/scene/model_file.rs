@@ -71,6 +71,10 @@ pub struct ModelFile {
     /// of older runs).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub obstacles: Vec<ModelObstacle>,
+    /// The unit direction pictures draw upwards, when it is not +y (`[output] up`, or
+    /// opposite `gravity`); absent: +y.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<[Real; 3]>,
 }
 
 /// The side of the square a half-space is drawn as, in bounding diagonals of the bodies.
@@ -213,12 +217,21 @@ impl ModelFile {
             scene: world.name.clone(),
             bodies,
             obstacles: model_obstacles(world),
+            up: (world.pictures.up != [0.0, 1.0, 0.0]).then_some(world.pictures.up),
         }
     }
 
     /// Whether every number in the file refers to something that exists (a torn or edited
     /// file is caught here rather than by an index out of range later). Returns the problem.
     pub fn problem(&self) -> Option<String> {
+        if let Some(up) = self.up {
+            let norm = up.iter().map(|x| x * x).sum::<Real>().sqrt();
+            if !(norm > 0.5 && norm < 2.0) {
+                return Some(format!(
+                    "its up direction {up:?} is not a unit vector: give [x, y, z] of length 1 (or leave it out for +y)"
+                ));
+            }
+        }
         for o in &self.obstacles {
             let n = o.vertices.len();
             if let Some(t) = o

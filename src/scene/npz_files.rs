@@ -278,7 +278,7 @@ pub(crate) fn read_step_npz(bytes: &[u8], model: &ModelFile) -> Result<StepResul
 /// name of each member's material) and, when a material has a strength, `_strengths` (m × 2,
 /// Pa: tension, compression; NaN for none); `obstacles` (names) and per
 /// obstacle `obstacle<k>_vertices` (v × 3), `_triangles` (t × 3, 1-based), `_offsets`
-/// ((steps + 1) × 3).
+/// ((steps + 1) × 3); `up` (3) when pictures draw another direction than +y upwards.
 pub(crate) fn model_npz(model: &ModelFile) -> std::io::Result<Vec<u8>> {
     let mut out = NpzOut::new();
     out.strs("scene", &[], &[model.scene.as_str()])?;
@@ -321,6 +321,9 @@ pub(crate) fn model_npz(model: &ModelFile) -> std::io::Result<Vec<u8>> {
     }
     let names: Vec<&str> = model.obstacles.iter().map(|o| o.name.as_str()).collect();
     out.strs("obstacles", &[names.len()], &names)?;
+    if let Some(up) = model.up {
+        out.f64s("up", &[3], up.iter())?;
+    }
     for (k, o) in model.obstacles.iter().enumerate() {
         let key = |field: &str| obstacle_key(k, field);
         out.f64s(
@@ -446,10 +449,18 @@ pub(crate) fn read_model_npz(bytes: &[u8]) -> Result<ModelFile, String> {
             offsets: triples(npz.f64s(&key("offsets"))?.rows(&key("offsets"), None, 3)?),
         });
     }
+    // Absent when +y, and in archives of older runs.
+    let up = if npz.contains("up") {
+        let v = npz.f64s("up")?.list("up", Some(3))?;
+        Some([v[0], v[1], v[2]])
+    } else {
+        None
+    };
     Ok(ModelFile {
         scene,
         bodies,
         obstacles,
+        up,
     })
 }
 
@@ -494,6 +505,7 @@ mod tests {
                 triangles: vec![[1, 3, 2]],
                 offsets: vec![[0.0; 3], [0.0, -1e-3, 0.0]],
             }],
+            up: Some([0.0, 0.0, 1.0]),
         }
     }
 

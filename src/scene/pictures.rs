@@ -31,6 +31,9 @@ pub struct PictureSettings {
     /// What colours members and surfaces (`[output] colour`): "stress", "max-stress" or
     /// "plain" (`None`: "stress").
     pub colour: Option<String>,
+    /// The unit direction drawn upwards in frames (`[output] up`, or opposite the scene's
+    /// `gravity`): default +y.
+    pub up: [Real; 3],
 }
 
 impl Default for PictureSettings {
@@ -47,6 +50,7 @@ impl Default for PictureSettings {
             azimuth: None,
             elevation: None,
             colour: None,
+            up: [0.0, 1.0, 0.0],
         }
     }
 }
@@ -58,6 +62,17 @@ pub const COLOURS: [&str; 3] = ["stress", "max-stress", "plain"];
 pub const MAX_FRAME_SIDE: u32 = 8192;
 
 impl PictureSettings {
+    /// Take "up" opposite `gravity` (m/s², one component per dimension) when it is not zero.
+    pub fn up_against(&mut self, gravity: &[Real]) {
+        let g: Vec<Real> = (0..3)
+            .map(|k| gravity.get(k).copied().unwrap_or(0.0))
+            .collect();
+        let norm = g.iter().map(|x| x * x).sum::<Real>().sqrt();
+        if norm > 0.0 && norm.is_finite() {
+            self.up = [-g[0] / norm, -g[1] / norm, -g[2] / norm];
+        }
+    }
+
     /// Switch on PNG frames and the GIF (the CLI's `--png`).
     pub fn ask_png(&mut self) {
         self.png = true;
@@ -98,6 +113,16 @@ impl PictureSettings {
                 ));
             }
         }
+        let up = match spec.up.as_deref() {
+            None | Some("y") => [0.0, 1.0, 0.0],
+            Some("x") => [1.0, 0.0, 0.0],
+            Some("z") => [0.0, 0.0, 1.0],
+            Some(u) => {
+                return Err(format!(
+                    "[output] up = {u:?}: give \"x\", \"y\" or \"z\" (the axis drawn upwards)"
+                ))
+            }
+        };
         let vtk_encoding = match spec.vtk_format.as_deref() {
             None => VtkEncoding::Binary,
             Some(f) => VtkEncoding::parse(f).ok_or_else(|| {
@@ -116,6 +141,7 @@ impl PictureSettings {
             azimuth: spec.azimuth,
             elevation: spec.elevation,
             colour: spec.colour.clone(),
+            up,
         })
     }
 }
@@ -144,5 +170,27 @@ mod tests {
             e.contains("vtk_format = \"xml\"") && e.contains("\"ascii\""),
             "{e}"
         );
+    }
+
+    #[test]
+    fn up_is_y_by_default_the_axis_given_or_opposite_gravity() {
+        let up = |u: Option<&str>| {
+            PictureSettings::from_spec(&OutputSpec {
+                up: u.map(String::from),
+                ..Default::default()
+            })
+        };
+        assert_eq!(up(None).unwrap().up, [0.0, 1.0, 0.0]);
+        assert_eq!(up(Some("z")).unwrap().up, [0.0, 0.0, 1.0]);
+        assert_eq!(up(Some("x")).unwrap().up, [1.0, 0.0, 0.0]);
+        let e = up(Some("-z")).unwrap_err();
+        assert!(e.contains("up = \"-z\"") && e.contains("\"z\""), "{e}");
+        // Gravity decides over the key: up is opposite it, a unit vector (3-4-5 triangle).
+        let mut s = up(Some("z")).unwrap();
+        s.up_against(&[3.0, -4.0]);
+        assert_eq!(s.up, [-0.6, 0.8, -0.0]);
+        // Zero gravity leaves it.
+        s.up_against(&[0.0, 0.0, 0.0]);
+        assert_eq!(s.up, [-0.6, 0.8, -0.0]);
     }
 }

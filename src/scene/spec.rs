@@ -585,6 +585,9 @@ pub struct OutputSpec {
     pub elevation: Option<Real>,
     /// What colours members and surfaces: "stress" (default), "max-stress" or "plain".
     pub colour: Option<String>,
+    /// The axis pictures draw upwards: "x", "y" (default) or "z"; the scene's `gravity`,
+    /// when given, decides instead (up is opposite it).
+    pub up: Option<String>,
     /// The node (1-based) whose displacement the load–displacement plot shows (default: the
     /// largest displacement of any node); see [`crate::scene::PlotSettings`].
     pub plot_node: Option<usize>,
