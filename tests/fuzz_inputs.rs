@@ -25,8 +25,10 @@ use std::time::{Duration, Instant};
 const DEFAULT_CASES: u32 = 250;
 /// The default seed.
 const DEFAULT_SEED: u64 = 0x6c69_6e6b_6167_6531;
-/// A case that takes more than this CPU time of the process hangs.
-const TIMEOUT: Duration = Duration::from_secs(20);
+/// A case that takes more than this CPU time of the process hangs. `wedge_split.toml` without
+/// its `softening` (brittle members: 559 breaks, a collapse at the fifth of its steps) takes 29 s
+/// of CPU time and is no hang.
+const TIMEOUT: Duration = Duration::from_secs(60);
 /// A case that takes more than this wall time hangs even without CPU time (a deadlock).
 const WALL_TIMEOUT: Duration = Duration::from_secs(600);
 /// How long a case raised for a hang is given to stop.
