@@ -172,7 +172,7 @@ fn newmark_cantilever_agrees_with_opensees_corot_truss() {
 }
 
 /// The benchmark (`cargo test --release --test opensees -- --ignored --nocapture`): the same
-/// cantilever of 200 × 10 cells (6,231 members, 4,422 DOFs), 50 steps, time per step ours and
+/// cantilever of 200 × 10 cells (8,210 members, 4,422 DOFs), 50 steps, time per step ours and
 /// OpenSees's in one run.
 #[test]
 #[ignore]
