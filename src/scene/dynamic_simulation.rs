@@ -6,6 +6,7 @@ use crate::linkage::dynamics::{
     TimeStepFailure, TimeStepReport,
 };
 use crate::linkage::{Body, PhaseTimes, SolveError};
+use crate::scene::dynamic_contact::DynamicContact;
 use crate::scene::dynamics_settings::DynamicsSettings;
 use crate::scene::results::{
     BodyMomentum, BodyResult, BodySize, StepEnergy, StepResult, StepSummary,
@@ -66,6 +67,8 @@ pub struct DynamicSimulation<'w> {
     /// Work of the applied forces and supports, and damping's dissipation, since t = 0, J.
     external_work: Real,
     dissipated: Real,
+    /// The contact solver, in a scene with contact (obstacles or `[contact]`).
+    contact: Option<DynamicContact>,
 }
 
 impl<'w> DynamicSimulation<'w> {
@@ -105,7 +108,13 @@ impl<'w> DynamicSimulation<'w> {
             }
             motions.push(m);
         }
+        let contact = if world.has_contact() {
+            Some(DynamicContact::new(world, settings.duration)?)
+        } else {
+            None
+        };
         Ok(DynamicSimulation {
+            contact,
             world,
             settings,
             integrator,
@@ -148,12 +157,23 @@ impl<'w> DynamicSimulation<'w> {
                 let ticks = (TICKS >> self.depth).min(total - pos);
                 let h = full * (ticks as Real / TICKS as Real);
                 let t0 = start + full * (pos as Real / TICKS as Real);
-                match solve_time_step(
-                    &mut self.motions,
-                    &world.bodies,
-                    self.integrator.as_ref(),
-                    (t0, h, duration),
-                ) {
+                let solved = match self.contact.as_mut() {
+                    Some(c) => c
+                        .solve(
+                            &mut self.motions,
+                            &world.bodies,
+                            self.integrator.as_ref(),
+                            (t0, h, self.depth < MAX_TIME_STEP_HALVINGS),
+                        )
+                        .map(|s| s.record(&mut summary)),
+                    None => solve_time_step(
+                        &mut self.motions,
+                        &world.bodies,
+                        self.integrator.as_ref(),
+                        (t0, h, duration),
+                    ),
+                };
+                match solved {
                     Ok(reports) => {
                         pos += ticks;
                         time_steps += 1;
@@ -217,7 +237,7 @@ impl<'w> DynamicSimulation<'w> {
             smallest_time_step: if time_steps > 0 { smallest } else { 0.0 },
             ..Default::default()
         };
-        for (body, m) in world.bodies.iter().zip(&self.motions) {
+        for (k, (body, m)) in world.bodies.iter().zip(&self.motions).enumerate() {
             let state = m.state(body, t, duration);
             summary.overloaded += state.overloaded.len();
             summary.max_displacement = state
@@ -247,10 +267,18 @@ impl<'w> DynamicSimulation<'w> {
                 momentum: momentum(body, &m.mass, &m.motion.v),
                 angular_momentum: angular_momentum(body, &m.mass, &m.motion.u, &m.motion.v),
             });
+            if let Some(c) = &self.contact {
+                c.write_contacts(k, body, &mut written);
+            }
             result.bodies.push(written);
         }
-        energy.total_energy =
-            energy.kinetic_energy + energy.strain_energy - energy.external_work + energy.dissipated;
+        if let Some(c) = &self.contact {
+            c.summarize(&world.bodies, &mut summary);
+            energy.contact_energy = c.penalty_energy;
+        }
+        energy.total_energy = energy.kinetic_energy + energy.strain_energy + energy.contact_energy
+            - energy.external_work
+            + energy.dissipated;
         summary.dynamics = Some(energy);
         Ok((result, summary))
     }

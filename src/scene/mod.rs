@@ -41,6 +41,7 @@ mod check;
 mod contact_concentration;
 mod contact_pairs;
 mod driver;
+mod dynamic_contact;
 mod dynamic_simulation;
 pub mod dynamics_settings;
 pub mod fits_machine;
