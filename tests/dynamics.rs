@@ -473,7 +473,7 @@ fn every_error_of_a_dynamic_scene_names_its_line() {
     );
     refused(
         &[("[dynamics]", "[[obstacles]]\nname = \"floor\"\nshape = \"half_space\"\npoint = [0.0, -1.0]\nnormal = [0.0, 1.0]\n\n[dynamics]\ndamping = { stiffness = 1e-3 }")],
-        10,
+        15,
         "[dynamics] damping.stiffness with contact (obstacles or a [contact] table) is not supported",
     );
     refused(
