@@ -472,9 +472,9 @@ fn every_error_of_a_dynamic_scene_names_its_line() {
         "a 2D body turns about z: give one finite number",
     );
     refused(
-        &[("[dynamics]", "[[obstacles]]\nname = \"floor\"\nshape = \"half_space\"\npoint = [0.0, -1.0]\nnormal = [0.0, 1.0]\n\n[dynamics]")],
-        10,
-        "[dynamics] with contact (obstacles or a [contact] table) is not yet supported",
+        &[("[dynamics]", "[[obstacles]]\nname = \"floor\"\nshape = \"half_space\"\npoint = [0.0, -1.0]\nnormal = [0.0, 1.0]\n\n[dynamics]\ndamping = { stiffness = 1e-3 }")],
+        15,
+        "[dynamics] damping.stiffness with contact (obstacles or a [contact] table) is not supported",
     );
     refused(
         &[("[dynamics]\nduration = 0.1\ntime_step = 0.01\nframes = 5\nintegrator = \"energy_momentum\"\n", "")],

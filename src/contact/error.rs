@@ -128,6 +128,15 @@ pub enum ContactError {
         /// The pseudo-time given.
         at: Real,
     },
+    /// A time step left a node deeper inside what it touches than allowed: the step was too
+    /// long for the contact set (the time driver halves it).
+    #[error("the time step left a node {depth:.3e} m deep, more than the {limit:.3e} m allowed: the contact set changed too much within the step")]
+    TimeStepTooDeep {
+        /// The largest penetration at the step's solution, m.
+        depth: Real,
+        /// The most allowed, m.
+        limit: Real,
+    },
     /// The result is not finite.
     #[error("step {step}: the solution with contact is not finite: check the penalty ([contact] penalty) and the loads")]
     NotFinite {

@@ -253,10 +253,13 @@ fn build_world_from(
         None => None,
     };
     if let Some(d) = &spec.dynamics {
-        if !spec.obstacles.is_empty() || spec.contact.is_some() {
+        let stiffness_damping = dynamics
+            .as_ref()
+            .is_some_and(|d| d.damping.stiffness != 0.0);
+        if (!spec.obstacles.is_empty() || spec.contact.is_some()) && stiffness_damping {
             return Err(at(
                 d.span(),
-                "[dynamics] with contact (obstacles or a [contact] table) is not yet supported: remove the obstacles and [contact], or remove [dynamics] for a quasi-static run".to_string(),
+                "[dynamics] damping.stiffness with contact (obstacles or a [contact] table) is not supported: the contact solver takes mass-proportional damping only. Use damping.mass, or the integrator's numerical damping (integrator = \"generalized_alpha\", rho_inf < 1)".to_string(),
             ));
         }
     }
@@ -357,8 +360,14 @@ fn build_world_from(
                 "obstacles need all bodies of one dimension (all 2D or all 3D)".to_string(),
             ));
         }
-        let (obstacle, note) = obstacle_from(o.get_ref(), dimension, spec.steps, &bodies, folder)
-            .map_err(|e| at(o.span(), e))?;
+        let (obstacle, note) = obstacle_from(
+            o.get_ref(),
+            dimension,
+            dynamics.is_none().then_some(spec.steps),
+            &bodies,
+            folder,
+        )
+        .map_err(|e| at(o.span(), e))?;
         found.extend(note);
         if obstacles.iter().any(|p| p.name == obstacle.name) {
             return Err(at(

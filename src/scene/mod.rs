@@ -42,6 +42,7 @@ mod check;
 mod contact_concentration;
 mod contact_pairs;
 mod driver;
+mod dynamic_contact;
 mod dynamic_fracture;
 mod dynamic_simulation;
 pub mod dynamics_settings;

@@ -20,7 +20,7 @@ use std::path::Path;
 pub(crate) fn obstacle_from(
     spec: &ObstacleSpec,
     dimension: Dimension,
-    steps: usize,
+    steps: Option<usize>,
     bodies: &[Body],
     folder: &Path,
 ) -> Result<(Obstacle, Option<String>), String> {
@@ -160,11 +160,17 @@ pub(crate) fn obstacle_from(
     };
     let schedule = match &spec.schedule {
         None => Schedule::Linear,
-        Some(f) if f.len() != steps => {
+        Some(f) if steps.is_some_and(|steps| f.len() != steps) => {
             return Err(fail(format!(
-            "`schedule` has {} factors but the scene has {steps} steps: give one factor per step",
-            f.len()
-        )))
+                "`schedule` has {} factors but the scene has {} steps: give one factor per step",
+                f.len(),
+                steps.unwrap_or(0)
+            )))
+        }
+        Some(f) if f.is_empty() => {
+            return Err(fail(
+                "`schedule` is empty: give at least one factor (they stand at equally spaced times over [dynamics] duration)".to_string(),
+            ))
         }
         Some(f) if f.iter().any(|x| !x.is_finite()) => {
             return Err(fail("`schedule` has a non-finite factor".to_string()))

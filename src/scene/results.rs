@@ -171,11 +171,15 @@ pub struct StepEnergy {
     pub kinetic_energy: Real,
     /// Strain energy of the members, J.
     pub strain_energy: Real,
-    /// Work of the applied forces (gravity included) and of the moving supports since t = 0, J.
+    /// Penalty energy `Σ ½ k d²` of the contacts, J (0 without contact).
+    #[serde(default)]
+    pub contact_energy: Real,
+    /// Work of the applied forces (gravity included), of the moving supports and of the moving
+    /// obstacles since t = 0, J.
     pub external_work: Real,
-    /// Energy dissipated since t = 0 (Rayleigh damping), J.
+    /// Energy dissipated since t = 0 (Rayleigh damping, friction's `μ f_N |slip|`), J.
     pub dissipated: Real,
-    /// The balance `kinetic + strain − external_work + dissipated`, J: constant for an
+    /// The balance `kinetic + strain + contact − external_work + dissipated`, J: constant for an
     /// integrator that conserves energy; its drift is the integrator's numerical dissipation.
     pub total_energy: Real,
     /// Time steps taken since the previous stored state.

@@ -646,7 +646,7 @@ fn add_newton_counts(summary: &mut StepSummary, state: &StepState) {
 }
 
 /// The written form of a body's contacts: 1-based nodes, one force component per dimension.
-fn contact_forces(body: &Body, contacts: &[NodeContact]) -> Vec<ContactForce> {
+pub(crate) fn contact_forces(body: &Body, contacts: &[NodeContact]) -> Vec<ContactForce> {
     let d = body.dimension.dofs_per_node();
     contacts
         .iter()
