@@ -448,6 +448,8 @@ fn prepare_writes_the_paper_files_and_the_report_the_same_every_time() {
             "volume",
             "member length",
             "dihedral angle",
+            "as a solid (uniaxial tests of the lattice): Young's modulus",
+            "Poisson's ratio",
         ] {
             assert!(stdout.contains(word), "{word}: {stdout}");
         }
