@@ -21,6 +21,74 @@ pub(crate) fn bench_contact(
     Ok(())
 }
 
+/// `linkage bench --dynamics`: the dropped lattice, then ours against OpenSees, in one run.
+pub(crate) fn bench_dynamics(
+    cells: Vec<[usize; 3]>,
+    steps: Option<usize>,
+    quick: bool,
+    python: Option<PathBuf>,
+) -> Result<()> {
+    use linkage::bench::{cholmod::load_average, dynamics, opensees};
+    let load = || load_average().map_or("?".to_string(), |l| format!("{l:.2}"));
+    say!("load average at start: {}", load());
+    let lattice = cells.first().copied().unwrap_or(if quick {
+        dynamics::QUICK_CELLS
+    } else {
+        dynamics::CELLS
+    });
+    let steps = steps.unwrap_or(if quick {
+        dynamics::QUICK_STEPS
+    } else {
+        dynamics::STEPS
+    });
+    say!(
+        "1. A 3D rubber box lattice thrown down at {} m/s under gravity onto a floor (half-space, \
+         penalty contact), energy-momentum, time step {} ms, {} steps of free fall then contact",
+        dynamics::SPEED,
+        dynamics::TIME_STEP * 1e3,
+        dynamics::STEPS_BEFORE_CONTACT
+    );
+    let t = dynamics::measure_dynamics(lattice, steps).map_err(anyhow::Error::msg)?;
+    for (k, s) in t.steps.iter().enumerate() {
+        say!("{}", dynamics::format_step(k + 1, s));
+    }
+    say!("{}", dynamics::format_summary(&t));
+    let python = python
+        .or_else(|| std::env::var_os("LINKAGE_OPENSEES_PYTHON").map(PathBuf::from))
+        .or_else(opensees::venv_python);
+    let (cells, run) = if quick {
+        (opensees::QUICK_CELLS, opensees::QUICK_RUN)
+    } else {
+        (opensees::CELLS, opensees::RUN)
+    };
+    say!(
+        "2. Newmark (1/4, 1/2), large displacements: a 2D lattice cantilever suddenly loaded at \
+         its tip, ours against OpenSees (corotTruss, UmfPack, Newton, NormDispIncr 1e-12)"
+    );
+    if python.is_none() {
+        say!(
+            "no Python with openseespy found: OpenSees is not run, ours is timed alone. To \
+             compare: {}",
+            opensees::INSTALL
+        );
+    }
+    let dir = tempfile_dir("linkage-bench-opensees")?;
+    let compared = opensees::compare(cells, run, python.as_deref(), &dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    let c = compared.map_err(anyhow::Error::msg)?;
+    say!("{}", opensees::format_comparison(&c));
+    say!("load average at end: {}", load());
+    if let Some((_, d)) = c.theirs {
+        if d > opensees::AGREEMENT {
+            bail!(
+                "ours and OpenSees differ by {d:.2e} of the peak tip displacement (at most {:e} expected)",
+                opensees::AGREEMENT
+            );
+        }
+    }
+    Ok(())
+}
+
 pub(crate) fn bench_fracture(cells: Vec<[usize; 3]>, breaks: Option<usize>) -> Result<()> {
     let cells = cells.first().copied().unwrap_or([20, 20, 20]);
     let breaks = breaks.unwrap_or(1000);

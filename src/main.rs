@@ -14,8 +14,8 @@ mod bench_cli;
 
 use anyhow::{bail, Context, Result};
 use bench_cli::{
-    bench, bench_cholmod, bench_contact, bench_fracture, bench_gif, bench_large, bench_prepare,
-    bench_read, bench_render, bench_run,
+    bench, bench_cholmod, bench_contact, bench_dynamics, bench_fracture, bench_gif, bench_large,
+    bench_prepare, bench_read, bench_render, bench_run,
 };
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -167,7 +167,8 @@ enum Command {
         /// With --large: total side force, N (default: 2.5e5, bending the default column by about 40 % of its length).
         #[arg(long)]
         force: Option<f64>,
-        /// With --large: load steps (default 5).
+        /// With --large: load steps (default 5); with --contact: contact steps (default 2);
+        /// with --dynamics: time steps (default 20, 3 of them before the lattice touches).
         #[arg(long)]
         steps: Option<usize>,
         /// Run a box lattice's scene end to end through `linkage run` instead (default
@@ -205,9 +206,22 @@ enum Command {
         #[arg(long, requires = "cholmod", default_value_t = 3)]
         reps: usize,
         /// With --cholmod: the Python with numpy, scipy and scikit-sparse (default: the
-        /// environment variable LINKAGE_CHOLMOD_PYTHON, else python3).
-        #[arg(long, requires = "cholmod")]
+        /// environment variable LINKAGE_CHOLMOD_PYTHON, else python3). With --dynamics: the
+        /// Python with openseespy (default: LINKAGE_OPENSEES_PYTHON, else the venv
+        /// target/opensees-venv next to this executable; without one OpenSees is not run).
+        #[arg(long)]
         python: Option<PathBuf>,
+        /// Dynamics instead, two benchmarks in one run: a 3D box lattice with density
+        /// (default 20x20x20 cells, 108,860 members) dropped on a floor with contact
+        /// (energy-momentum; model size, time per time step, steps per second, phases), then
+        /// our Newmark against OpenSees on a 200x10-cell 2D cantilever (time per step of both,
+        /// their ratio and the agreement of the tip histories to 1e-6).
+        #[arg(long)]
+        dynamics: bool,
+        /// With --dynamics: a CI-size run (a 5x5x5-cell lattice, 8 time steps; the 10x1-cell
+        /// cantilever).
+        #[arg(long, requires = "dynamics")]
+        quick: bool,
         /// Time drawing one frame of a shaded shell instead (see --patches, --size).
         #[arg(long)]
         render: bool,
@@ -398,6 +412,14 @@ fn main() -> ExitCode {
             breaks,
             ..
         } => bench_fracture(cells, breaks),
+        Command::Bench {
+            cells,
+            dynamics: true,
+            steps,
+            quick,
+            python,
+            ..
+        } => bench_dynamics(cells, steps, quick, python),
         Command::Bench {
             cells,
             contact: true,

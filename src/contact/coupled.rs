@@ -203,12 +203,19 @@ impl CoupledSolver {
             }
             // Linear bodies with the same contacts keep their tangent but for the small turn of
             // the contact normals: reuse the factor (a modified Newton step) while it converges.
-            let reuse = linear
+            // Within a time step the factor of the last one serves from the first iteration
+            // when the step size (the coefficient of `c M`) and the contact set are the same:
+            // a body in free flight, or resting on a plane, is not refactored at every step.
+            let same_tangent = linear
                 && self.iterative.is_none()
                 && self.factored.as_ref() == Some(p.set)
-                && self.factored_inertia == inertia_coefficients(p)
-                && iterations > 0
-                && monitor.converging_fast();
+                && self.factored_inertia == inertia_coefficients(p);
+            let reuse = same_tangent
+                && if iterations == 0 {
+                    p.inertia.is_some()
+                } else {
+                    monitor.converging_fast()
+                };
             let (stabilised, delta) = if reuse {
                 let t = Instant::now();
                 let mut delta = r;

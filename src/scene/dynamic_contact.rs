@@ -29,7 +29,7 @@ use crate::contact::{penetration_tolerance, ContactError, ContactSolver, NodeCon
 use crate::linkage::dynamics::{
     time_factor, BodyMotion, InertiaTerm, Integrator, TimeStepFailure, TimeStepReport,
 };
-use crate::linkage::{Body, Schedule};
+use crate::linkage::{Body, PhaseTimes, Schedule};
 use crate::scene::results::{BodyResult, PairForce, StepSummary};
 use crate::scene::run_error::RunError;
 use crate::scene::simulation::contact_forces;
@@ -309,6 +309,16 @@ impl ContactTimeStep {
 }
 
 impl DynamicContact {
+    /// Time the contact solver spent in each phase so far, s.
+    pub fn times(&self) -> PhaseTimes {
+        self.solver.times
+    }
+
+    /// Time the contact solver spent finding contacts so far, s.
+    pub fn query_seconds(&self) -> Real {
+        self.solver.query_seconds
+    }
+
     /// Body `k`'s contacts at the last time step into its written result.
     pub fn write_contacts(&self, k: usize, body: &Body, written: &mut BodyResult) {
         if let Some(c) = self.contacts.get(k) {

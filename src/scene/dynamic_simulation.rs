@@ -350,16 +350,28 @@ impl<'w> DynamicSimulation<'w> {
             .collect()
     }
 
-    /// Time spent in each phase, summed over the bodies, s.
+    /// Time spent in each phase, summed over the bodies and the contact solver, s.
     pub fn times(&self) -> PhaseTimes {
         let mut sum = PhaseTimes::default();
-        for m in &self.motions {
-            sum.assembly += m.times.assembly;
-            sum.symbolic += m.times.symbolic;
-            sum.numeric += m.times.numeric;
-            sum.solve += m.times.solve;
+        let contact = self.contact.as_ref().map(|c| c.times());
+        for t in self
+            .motions
+            .iter()
+            .map(|m| &m.times)
+            .chain(contact.as_ref())
+        {
+            sum.assembly += t.assembly;
+            sum.symbolic += t.symbolic;
+            sum.numeric += t.numeric;
+            sum.solve += t.solve;
         }
         sum
+    }
+
+    /// Time spent finding contacts (projecting nodes on obstacles and bodies), s; 0 without
+    /// contact.
+    pub fn query_seconds(&self) -> Real {
+        self.contact.as_ref().map_or(0.0, |c| c.query_seconds())
     }
 }
 

@@ -55,7 +55,7 @@ impl<'w> Stepper<'w> {
     pub fn times(&self) -> (PhaseTimes, Real) {
         match self {
             Stepper::Static(s) => s.times(),
-            Stepper::Dynamic(d) => (d.times(), 0.0),
+            Stepper::Dynamic(d) => (d.times(), d.query_seconds()),
         }
     }
 }
