@@ -476,3 +476,44 @@ fn friction_that_drags_a_pressed_truss_sideways_breaks_a_second_bar() {
     );
     assert!(forces.iter().all(|f| f.abs() < 1e-6), "{forces:?}");
 }
+
+/// Softening under large displacements: the hanger (f_t = 4 MPa) softens in 2 teeth with
+/// G_f = 7e4 J/m², which puts its second tooth at ε₁ = 0.04 (D(h) = ½ f_t ε₀ − ½ (f_t/2) ε₀²/ε₁
+/// + ½ (f_t/2) ε₁ = 7e4 J/m³ with ε₀ = 0.02) and E₁ = 2e6/0.04 = 5e7 Pa. Under 2800 N over 4
+/// steps it passes tooth 1 at the same closed-form load as the brittle hanger (1696.95 N,
+/// step 3), then breaks at its second tooth when the apex is 0.04 m down:
+/// P = P_vm(0.04) + E₁ A 0.04 = 2395.19 N (step 4); both to 1e-8.
+#[test]
+fn a_softening_member_of_a_large_body_passes_its_teeth_at_the_closed_form_loads() {
+    let mut soft = breaking(hanger(), Some(4e6), None);
+    soft.softening = Some(linkage::linkage::Softening {
+        fracture_energy: 7e4,
+        teeth: 2,
+    });
+    let body = hung_truss(Kinematics::Large, 2800.0, bar(), soft);
+    let mut eq = LargeBreakingEquilibrium::new(&body).unwrap();
+    let mut events = Vec::new();
+    for s in 0..=4 {
+        let state = eq.solve_step(&body, s, 4).unwrap();
+        for b in state.fracture.unwrap().breaks {
+            events.push((s, b));
+        }
+    }
+    assert_eq!(events.len(), 2, "{events:?}");
+    let (s1, first) = events[0];
+    let (s2, second) = events[1];
+    assert_eq!((s1, first.member, first.tooth), (3, 2, Some(1)));
+    assert_eq!((s2, second.member, second.tooth), (4, 2, None));
+    let p1 = 700.0 * (2.0 + first.fraction);
+    let p2 = 700.0 * (3.0 + second.fraction);
+    let closed1 = load_at(0.02);
+    let closed2 = load_at(0.04) - EA_HANGER * 0.04 + 5e7 * 1e-4 * 0.04;
+    assert!(
+        (p1 - closed1).abs() <= 1e-8 * closed1,
+        "{p1} N, {closed1} N"
+    );
+    assert!(
+        (p2 - closed2).abs() <= 1e-8 * closed2,
+        "{p2} N, {closed2} N"
+    );
+}
