@@ -478,8 +478,8 @@ fn friction_that_drags_a_pressed_truss_sideways_breaks_a_second_bar() {
 }
 
 /// Softening under large displacements: the hanger (f_t = 4 MPa) softens in 2 teeth with
-/// G_f = 7e4 J/m², which puts its second tooth at ε₁ = 0.04 (D(h) = ½ f_t ε₀ − ½ (f_t/2) ε₀²/ε₁
-/// + ½ (f_t/2) ε₁ = 7e4 J/m³ with ε₀ = 0.02) and E₁ = 2e6/0.04 = 5e7 Pa. Under 2800 N over 4
+/// G_f = 7e4 J/m², which puts its second tooth at ε₁ = 0.04 and E₁ = 2e6/0.04 = 5e7 Pa: the
+/// dissipation `½ f_t ε₀ − ½ (f_t/2) ε₀²/ε₁ + ½ (f_t/2) ε₁` is 7e4 J/m³ with ε₀ = 0.02. Under 2800 N over 4
 /// steps it passes tooth 1 at the same closed-form load as the brittle hanger (1696.95 N,
 /// step 3), then breaks at its second tooth when the apex is 0.04 m down:
 /// P = P_vm(0.04) + E₁ A 0.04 = 2395.19 N (step 4); both to 1e-8.
