@@ -93,10 +93,11 @@ penalty = 1e9
     assert_eq!(step4["bodies"][0]["breaks"][0]["member"], 2);
 }
 
-/// Breaking members with friction are not supported yet: refused with an error naming the body
-/// and what to change, before anything is solved.
+/// Breaking members with friction are followed (tests/fracture_large.rs), but not along an
+/// arc-length path: refused with an error naming the body and what to change, before anything
+/// is solved.
 #[test]
-fn breaking_members_with_friction_are_refused_by_name() {
+fn breaking_members_on_an_arc_length_path_with_contact_are_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("t.nodes"), "0 0\n-1 1\n0 1\n1 1\n").unwrap();
@@ -119,6 +120,9 @@ material = "steel"
 [[bodies.supports]]
 nodes = [2, 3, 4]
 fix = ["x", "y"]
+[bodies.path]
+method = "arc_length"
+arc_length = 0.001
 [[obstacles]]
 name = "floor"
 shape = "half_space"
@@ -134,7 +138,7 @@ friction = 0.3
     let err = run(&world, &d.join("out"), &|| {}).unwrap_err();
     let text = format!("{err:#}");
     assert!(
-        text.contains("body 'truss'") && text.contains("friction"),
+        text.contains("body 'truss'") && text.contains("arc-length"),
         "{text}"
     );
     assert!(!d.join("out/rough").exists());

@@ -21,6 +21,19 @@
 //! next break is recorded at its lower load (the fraction of the step's increment below the
 //! previous break's, below 0 when it lies in an earlier step's).
 //!
+//! A body under large displacements (or with tension- or compression-only members) breaks the
+//! same way: its members' stresses are those the results report (the member response at the
+//! displacement), not linear in the load even on a fixed contact set, so the secant is only a
+//! first guess and the bracket is narrowed by settles until the member is at its strength.
+//!
+//! With friction, every settle of the search is one increment of friction's history from the
+//! step's start (a step cut into increments is settled again at its end as one), and after a
+//! break the history is committed at the break's state, so what follows starts from the slip
+//! there; at the step's end it is committed as without fracture. The load is never lowered: the
+//! state of a body with friction at a lower load depends on the way there, so members beyond
+//! their strength just after a break (a snap-back without friction) break at that break's load,
+//! one event after the other.
+//!
 //! A broken member keeps its place in the body with a modulus factor of zero (a softened one:
 //! its tooth's, [`Body::member_factors`]), so numbering, patterns, surfaces and the materials
 //! stay. Contact
@@ -37,7 +50,7 @@
 //! cannot be settled, the break is the structure's collapse.
 
 use crate::contact::{ContactError, ContactSolver, ContactStep, Obstacle, Target};
-use crate::linkage::body_state::{linear_stretch, undeformed_axis};
+use crate::linkage::body_state::{linear_stretch, member_response_at, undeformed_axis};
 use crate::linkage::fracture::{
     breaks_members, critical_fraction, member_limits, released_pieces, BreakEvent, FallenPiece,
     FractureState, MemberLimits, Tooth,
@@ -154,6 +167,16 @@ impl ContactFracture {
                 let Some(br) = br else { return Vec::new() };
                 let body = &self.original[b];
                 let u = &solver.parts[b].u;
+                if body.is_nonlinear() {
+                    // Large displacements or slack members: the stress the results report.
+                    let now = &self.bodies[b];
+                    return (0..now.members.len())
+                        .map(|m| {
+                            let area = now.materials[now.members[m].material].area;
+                            member_response_at(now, u, m).force / area
+                        })
+                        .collect();
+                }
                 let d = body.dimension.dofs_per_node();
                 body.members
                     .iter()
@@ -350,8 +373,28 @@ impl ContactFracture {
                 l.iter_mut().for_each(|v| *v = 0.0);
             }
         }
+        // Friction's history at the step's start: the search settles every trial load as one
+        // increment from there (or from the last break's state, committed after it).
+        let history = solver.friction.clone();
         let out = solver.settle_step(&self.bodies, obstacles, step, steps)?;
         self.now = step as Real;
+        let friction = history.is_some();
+        if friction && step > 0 && out.cuts > 0 {
+            // The cut step committed friction's history at its increments: settle the step's
+            // end again as one increment from its start, as the search settles its loads.
+            let reached = solver.friction.clone();
+            let saved = solver.converged_state();
+            solver.friction = history.clone();
+            self.now = (step - 1) as Real;
+            if self
+                .settle(solver, obstacles, step as Real, (step, steps))
+                .is_err()
+            {
+                solver.restore(saved);
+                solver.friction = reached;
+            }
+            self.now = step as Real;
+        }
         let mut events: Vec<Vec<BreakEvent>> = vec![Vec::new(); self.bodies.len()];
         let mut fallen: Vec<Vec<FallenPiece>> = vec![Vec::new(); self.bodies.len()];
         if step > 0 {
@@ -408,11 +451,31 @@ impl ContactFracture {
                     }
                     if t == t_break {
                         after = self.stresses(solver);
+                        if friction {
+                            // The slip up to the break is history: what follows starts there.
+                            solver.commit_friction(&self.bodies, obstacles, t, steps, step);
+                        }
                     }
                 }
                 at_end = self.stresses(solver);
                 let over = self.beyond(&at_end);
-                if self.any_beyond(&after, &over) {
+                if friction {
+                    // With friction the state at a lower load depends on the way there: the
+                    // load is not lowered, members beyond their strength at the break's load
+                    // break there, one after the other (a cascade at that load).
+                    let top_stress = if self.any_beyond(&after, &over) {
+                        after.clone()
+                    } else {
+                        at_end.clone()
+                    };
+                    let top_t = if self.any_beyond(&after, &over) {
+                        t_break
+                    } else {
+                        end
+                    };
+                    (t_lo, lo) = (t_break, after);
+                    top = (top_t, top_stress);
+                } else if self.any_beyond(&after, &over) {
                     (t_lo, lo) = self.below(
                         solver,
                         obstacles,
@@ -437,6 +500,9 @@ impl ContactFracture {
         }
         // Reported once, after the step's breaks.
         let out = solver.report(&self.bodies, obstacles, step, steps, out)?;
+        if friction {
+            solver.commit_friction(&self.bodies, obstacles, step as Real, steps, step);
+        }
         self.last = self.stresses(solver);
         let states = self
             .breaking

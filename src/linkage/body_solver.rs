@@ -1,6 +1,6 @@
 //! The solver a body needs: the paper's linear superposition, or Newton for a nonlinear body.
 
-use crate::linkage::fracture::{breaks_members, BreakingEquilibrium};
+use crate::linkage::fracture::{breaks_members, BreakingEquilibrium, LargeBreakingEquilibrium};
 use crate::linkage::{
     Body, Equilibrium, NewtonEquilibrium, PhaseTimes, SolveError, SolverUsed, StepState,
 };
@@ -14,20 +14,18 @@ pub enum BodySolver {
     Nonlinear(Box<NewtonEquilibrium>),
     /// Linear, with members that break: factor once, break members event by event.
     Breaking(Box<BreakingEquilibrium>),
+    /// Nonlinear (by load control), with members that break: Newton, each break at the load
+    /// found by a search over Newton solves.
+    LargeBreaking(Box<LargeBreakingEquilibrium>),
 }
 
 impl BodySolver {
     /// Validate `body` and prepare its solver (for a linear body: solve it).
     pub fn new(body: &Body) -> Result<Self, SolveError> {
         let breaking = breaks_members(body);
-        if breaking && body.is_nonlinear() {
-            return Err(SolveError::BreakingUnsupported {
-                body: body.name.clone(),
-                reason: "need a linear body, and this one has large kinematics, an arc-length path or tension- or compression-only members".to_string(),
-                remedy: "make the body linear (kinematics = \"linear\", elastic members, path by schedules)".to_string(),
-            });
-        }
-        Ok(if breaking {
+        Ok(if breaking && body.is_nonlinear() {
+            BodySolver::LargeBreaking(Box::new(LargeBreakingEquilibrium::new(body)?))
+        } else if breaking {
             BodySolver::Breaking(Box::new(BreakingEquilibrium::new(body)?))
         } else if body.is_nonlinear() {
             BodySolver::Nonlinear(Box::new(NewtonEquilibrium::new(body)?))
@@ -48,6 +46,7 @@ impl BodySolver {
             BodySolver::Linear(eq) => eq.solve_step(body, step, steps),
             BodySolver::Nonlinear(newton) => newton.solve_step(body, step, steps),
             BodySolver::Breaking(eq) => eq.solve_step(body, step, steps),
+            BodySolver::LargeBreaking(eq) => eq.solve_step(body, step, steps),
         }
     }
 
@@ -58,6 +57,7 @@ impl BodySolver {
             BodySolver::Linear(eq) => eq.solver_used,
             BodySolver::Nonlinear(newton) => newton.solver_used(),
             BodySolver::Breaking(_) => SolverUsed::Direct,
+            BodySolver::LargeBreaking(eq) => eq.newton.solver_used(),
         }
     }
 
@@ -67,6 +67,7 @@ impl BodySolver {
             BodySolver::Linear(eq) => eq.free_dofs,
             BodySolver::Nonlinear(newton) => newton.assembly.n,
             BodySolver::Breaking(eq) => eq.assembly.n,
+            BodySolver::LargeBreaking(eq) => eq.newton.assembly.n,
         }
     }
 
@@ -76,6 +77,7 @@ impl BodySolver {
             BodySolver::Linear(eq) => eq.times,
             BodySolver::Nonlinear(newton) => newton.times,
             BodySolver::Breaking(eq) => eq.times,
+            BodySolver::LargeBreaking(eq) => eq.times(),
         }
     }
 }

@@ -61,15 +61,15 @@ impl<'w> Simulation<'w> {
                     remedy: remedy.to_string(),
                 },
             };
+            // Breaking bodies in contact: nonlinear ones too (their members' stresses as the
+            // results report them), with friction too (see `ContactFracture`); an arc-length
+            // path is refused with contact for every body (the contact solver's own error).
             for body in world.bodies.iter().filter(|b| breaks_members(b)) {
-                if body.is_nonlinear() {
-                    return Err(refused(body, "need a linear body, and this one has large kinematics, an arc-length path or tension- or compression-only members", "make the body linear (kinematics = \"linear\", elastic members, path by schedules)"));
-                }
-                if world.contact.friction.any() {
+                if let crate::linkage::PathMethod::ArcLength { .. } = body.newton.path {
                     return Err(refused(
                         body,
-                        "are not supported yet in a scene with friction",
-                        "make the contacts frictionless (no [contact] friction)",
+                        "are not followed along an arc-length path (the search for a member's critical load moves the load, which the arc length sets)",
+                        "follow the path by its schedules ([bodies.path] method = \"schedules\")",
                     ));
                 }
             }
@@ -386,6 +386,7 @@ impl<'w> Simulation<'w> {
             };
             let tension = |m: usize| match &solvers[b] {
                 BodySolver::Breaking(eq) => eq.broke_in_tension(m),
+                BodySolver::LargeBreaking(eq) => eq.broke_in_tension(m),
                 _ => false,
             };
             let fallen = fracture.fallen.iter().flat_map(|p| p.nodes.iter().copied());

@@ -2,6 +2,23 @@
 
 use crate::Real;
 
+/// A member is at its strength when its stress is within this fraction of it (a Newton
+/// solve to a relative residual of 1e-10 or below leaves the stresses accurate to about
+/// this). The event searches in time ([`crate::scene::BreakingBodies`]), with contact and
+/// under large displacements stop there.
+pub const AT_STRENGTH: Real = 1e-8;
+
+/// A member's stress `s` (Pa, tension positive) over its strength in that sense: `s/f_t` in
+/// tension, `−s/f_c` in compression (`tensile` f_t and `compressive` f_c positive Pa,
+/// infinite for none: the ratio is then 0).
+pub fn strength_ratio(s: Real, tensile: Real, compressive: Real) -> Real {
+    if s >= 0.0 {
+        s / tensile
+    } else {
+        -s / compressive
+    }
+}
+
 /// For a member whose stress along a load increment is `σ(t) = a + t b` (Pa, tension
 /// positive; `t = 0` at the previous step's load, `t = 1` at this step's), the `t` at which it
 /// reaches its strength, when it is beyond it at `t = 1`: `(f_t − a)/b` in tension,
@@ -36,6 +53,13 @@ mod tests {
             critical_fraction(10.0, 10.0, Real::INFINITY, Real::INFINITY),
             None
         );
+    }
+
+    #[test]
+    fn the_strength_ratio_takes_the_strength_of_the_stress_sense() {
+        assert_eq!(strength_ratio(30.0, 20.0, 60.0), 1.5);
+        assert_eq!(strength_ratio(-30.0, 20.0, 60.0), 0.5);
+        assert_eq!(strength_ratio(-30.0, 20.0, Real::INFINITY), 0.0);
     }
 
     #[test]

@@ -3,8 +3,9 @@
 pub use self::breaking_equilibrium::{
     member_teeth, BreakingEquilibrium, MemberLimits, DEFAULT_REFACTOR_EVERY,
 };
-pub use self::critical::critical_fraction;
+pub use self::critical::{critical_fraction, strength_ratio, AT_STRENGTH};
 pub use self::events::{breaks_members, BreakEvent, FallenPiece, FractureState};
+pub use self::large_breaking::LargeBreakingEquilibrium;
 pub use self::pieces::{released_pieces, unsupported_pieces};
 pub use self::scatter::{member_limits, weibull_factors};
 pub use self::softening::{saw_tooth, saw_tooth_dissipation, Tooth};
@@ -12,6 +13,7 @@ pub use self::softening::{saw_tooth, saw_tooth_dissipation, Tooth};
 mod breaking_equilibrium;
 mod critical;
 mod events;
+mod large_breaking;
 mod pieces;
 mod scatter;
 mod softening;

@@ -21,16 +21,33 @@ impl NewtonEquilibrium {
         target: usize,
         steps: usize,
     ) -> Result<(usize, usize), SolveError> {
-        let end = target as Real;
-        let mut t = (target - 1) as Real;
+        self.advance_between(body, (target - 1) as Real, target as Real, target, steps)
+    }
+
+    /// Load control from the current state, solved at pseudo-time `from` (step units), to
+    /// pseudo-time `to`, up or down (a fracture search moves the load both ways), in
+    /// increments of at most a step halved when they do not converge; `step` names the step
+    /// in errors. Returns (Newton iterations, cuts).
+    pub(crate) fn advance_between(
+        &mut self,
+        body: &Body,
+        from: Real,
+        to: Real,
+        step: usize,
+        steps: usize,
+    ) -> Result<(usize, usize), SolveError> {
+        let (end, up) = (to, to >= from);
+        let mut t = from;
         let mut size = IncrementSize::default();
         let mut iterations = 0;
-        while t < end {
+        while if up { t < end } else { t > end } {
             let dt = size.fraction();
-            let t1 = if end - t <= dt * (1.0 + 1e-12) {
+            let t1 = if (end - t).abs() <= dt * (1.0 + 1e-12) {
                 end
-            } else {
+            } else if up {
                 t + dt
+            } else {
+                t - dt
             };
             let saved = self.u.clone();
             self.increment_pivots = 0;
@@ -48,7 +65,7 @@ impl NewtonEquilibrium {
                 Err(failure) => {
                     iterations += failure.solves;
                     self.u = saved;
-                    size.retry(body, target, failure)?;
+                    size.retry(body, step, failure)?;
                 }
             }
         }

@@ -26,6 +26,9 @@ use std::time::Instant;
 
 mod arc_length;
 mod load_control;
+mod saved;
+
+pub use self::saved::SavedNewton;
 
 /// The reason of an increment stopped by [`crate::linkage::Interrupt`] (never retried: the
 /// retry returns [`SolveError::Interrupted`]).
@@ -283,16 +286,8 @@ impl NewtonEquilibrium {
         steps: usize,
     ) -> Result<StepState, SolveError> {
         if step < self.step || step == 0 {
-            self.u.iter_mut().for_each(|v| *v = 0.0);
-            self.previous.iter_mut().for_each(|v| *v = 0.0);
-            self.lambda = 0.0;
-            self.step = 0;
-            self.negative_pivots = 0;
-            self.last_change = 0.0;
-            self.force_floor = 0.0;
-            self.displacement_floor = 0.0;
             // Step 0 (no load, no support moved) is in equilibrium undeformed.
-            self.path = vec![(0.0, self.u.clone())];
+            self.start_over();
         }
         let mut iterations = 0;
         let mut cuts = 0;
@@ -315,6 +310,21 @@ impl NewtonEquilibrium {
             cuts += c;
             self.step = target;
         }
+        self.finish_step(body, (step, steps), (iterations, cuts), cg_before)
+    }
+
+    /// The state of `step` of `steps` at the current displacement, which is solved at that
+    /// step's load, with the step's Newton `iterations` and `cuts` and the conjugate-gradient
+    /// iterations counted before it (`cg_before`); [`SolveError::Inaccurate`] when it holds
+    /// numbers that are not finite.
+    pub(crate) fn finish_step(
+        &mut self,
+        body: &Body,
+        (step, steps): (usize, usize),
+        (iterations, cuts): (usize, usize),
+        cg_before: usize,
+    ) -> Result<StepState, SolveError> {
+        self.step = step;
         let mut state = self.state(body, steps);
         state.iterations = iterations;
         state.cuts = cuts;
