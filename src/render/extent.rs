@@ -50,6 +50,10 @@ pub struct RunExtent {
     pub last_step: usize,
     /// The unit direction drawn upwards (the model's `up`, +y when it has none).
     pub up: Vector3<Real>,
+    /// A dynamic run's GIF plays this many times slower than real time (1: real time), as
+    /// [`crate::render::timed_delays`] chose: the frame titles state it. `None` (measured
+    /// extents): no GIF timed by the run's times, nothing stated.
+    pub gif_slowdown: Option<Real>,
 }
 
 fn vec3(p: &[Real]) -> Vector3<Real> {
@@ -250,6 +254,7 @@ impl RunExtent {
             node_peak_limit,
             last_step,
             up: model.up.map_or_else(Vector3::y, |u| vec3(&u)),
+            gif_slowdown: None,
         }
     }
 }

@@ -39,6 +39,24 @@ pub fn timed_delays(times: &[Real], last: u16) -> Option<(Vec<u16>, Real)> {
     Some((delays, slowdown))
 }
 
+/// How a frame's title states the pace of the GIF it is in, for the `slowdown` that
+/// [`timed_delays`] returned: `"real time"` at 1, else `"shown 100× slower"` (the factor as a
+/// whole number, thousands grouped by commas: `"shown 10,000× slower"`).
+pub fn pace_label(slowdown: Real) -> String {
+    if slowdown <= 1.0 {
+        return "real time".to_string();
+    }
+    let digits = format!("{:.0}", slowdown.round());
+    let mut grouped = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            grouped.push(',');
+        }
+        grouped.push(c);
+    }
+    format!("shown {grouped}× slower")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -56,5 +74,18 @@ mod tests {
         assert_eq!((d, s), (vec![5, 200], 1e4));
         assert!(timed_delays(&[0.0], 200).is_none());
         assert!(timed_delays(&[0.0, 0.0], 200).is_none());
+    }
+
+    #[test]
+    fn the_pace_is_stated_in_words_with_the_factor_grouped() {
+        assert_eq!(pace_label(1.0), "real time");
+        assert_eq!(pace_label(10.0), "shown 10× slower");
+        assert_eq!(pace_label(100.0), "shown 100× slower");
+        assert_eq!(pace_label(1e3), "shown 1,000× slower");
+        assert_eq!(pace_label(1e4), "shown 10,000× slower");
+        assert_eq!(pace_label(1e6), "shown 1,000,000× slower");
+        // The factor timed_delays picks for frames 1 ms apart, in words.
+        let (_, s) = timed_delays(&[0.0, 1e-3, 2e-3], 200).unwrap();
+        assert_eq!(pace_label(s), "shown 100× slower");
     }
 }

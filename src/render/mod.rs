@@ -15,7 +15,7 @@ pub use self::error::RenderError;
 pub use self::extent::{auto_magnification, RunExtent};
 pub use self::frame::Frame;
 pub use self::gif::{EncodedFrame, GifAnimation, GifPalette};
-pub use self::gif_timing::timed_delays;
+pub use self::gif_timing::{pace_label, timed_delays};
 pub use self::options::{Colouring, Projection, RenderOptions, StepSelection};
 pub use self::picture::{camera_for, draw_frame, frame_primitives, view_for, viewport_for};
 pub use self::primitives::{paint, Layer, Mesh, MeshKind, Primitive};

@@ -5,7 +5,7 @@ use crate::render::colour_scale::{
     SLIP_MAGENTA, STICK_GREEN, SUPPORT_TEAL,
 };
 use crate::render::text::{draw_text, text_width};
-use crate::render::{Frame, Rgb};
+use crate::render::{pace_label, Frame, Rgb};
 use crate::Real;
 use tiny_skia::{FillRule, LineCap, Paint, PathBuilder, Rect, Stroke, Transform};
 
@@ -60,6 +60,9 @@ pub struct Caption {
     /// Time of the state drawn, s (a dynamic scene: the title shows it instead of the load
     /// factor).
     pub time: Option<Real>,
+    /// The slow-down of the GIF the frame is in (a dynamic run, see
+    /// [`crate::render::timed_delays`]): the title states it after the time.
+    pub gif_slowdown: Option<Real>,
     /// Largest displacement at this step, m.
     pub max_displacement: Real,
     /// Overloaded members at this step.
@@ -108,6 +111,33 @@ fn fmt_number(v: Real) -> String {
     s.replace('-', "−")
 }
 
+/// The caption's title line: the scene, then `t = 1.20 ms, shown 10× slower  ·  frame k of n`
+/// for a dynamic run (the GIF's pace when it has one, see [`pace_label`]), else the step and
+/// its load factor.
+pub fn title(c: &Caption) -> String {
+    match c.time {
+        Some(t) => {
+            let pace = c
+                .gif_slowdown
+                .map_or(String::new(), |s| format!(", {}", pace_label(s)));
+            format!(
+                "{}  ·  t = {}{pace}  ·  frame {} of {}",
+                c.scene,
+                format_si(t, "s"),
+                c.step,
+                c.last_step
+            )
+        }
+        None => format!(
+            "{}  ·  step {} of {}  ·  load factor {}",
+            c.scene,
+            c.step,
+            c.last_step,
+            fmt_load(c.load_factor)
+        ),
+    }
+}
+
 /// Draw the caption (scene, step, load factor), the magnification, the stress colour bar
 /// and the legend onto `frame`.
 pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
@@ -116,22 +146,7 @@ pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
     let big = 26.0 * ui;
     let small = 17.0 * ui;
     let x = 40.0 * ui;
-    let title = match c.time {
-        Some(t) => format!(
-            "{}  ·  t = {}  ·  frame {} of {}",
-            c.scene,
-            format_si(t, "s"),
-            c.step,
-            c.last_step
-        ),
-        None => format!(
-            "{}  ·  step {} of {}  ·  load factor {}",
-            c.scene,
-            c.step,
-            c.last_step,
-            fmt_load(c.load_factor)
-        ),
-    };
+    let title = title(c);
     draw_text(&mut frame.pixmap, &title, x, 46.0 * ui, big, INK);
     let mut sub = format!("max |u| = {}", format_si(c.max_displacement, "m"));
     sub.push_str(&format!(
@@ -430,5 +445,54 @@ fn fmt_magnification(m: Real) -> String {
             .trim_end_matches('0')
             .trim_end_matches('.')
             .to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn caption(time: Option<Real>, gif_slowdown: Option<Real>) -> Caption {
+        Caption {
+            scene: "drop".to_string(),
+            step: 3,
+            last_step: 60,
+            load_factor: 0.05,
+            time,
+            gif_slowdown,
+            max_displacement: 0.0,
+            overloaded: 0,
+            broken: None,
+            peak_stress: None,
+            magnification: 1.0,
+            stress_bar: None,
+            max_force: 0.0,
+            max_contact: 0.0,
+            friction: false,
+            supports: false,
+            obstacles: false,
+        }
+    }
+
+    #[test]
+    fn a_dynamic_frame_title_states_its_time_and_the_gif_pace() {
+        assert_eq!(
+            title(&caption(Some(1.2e-3), Some(1000.0))),
+            "drop  ·  t = 1.20 ms, shown 1,000× slower  ·  frame 3 of 60"
+        );
+        assert_eq!(
+            title(&caption(Some(0.5), Some(1.0))),
+            "drop  ·  t = 500 ms, real time  ·  frame 3 of 60"
+        );
+        // PNG frames without a GIF: the time alone.
+        assert_eq!(
+            title(&caption(Some(1.2e-3), None)),
+            "drop  ·  t = 1.20 ms  ·  frame 3 of 60"
+        );
+        // A quasi-static run: the load factor.
+        assert_eq!(
+            title(&caption(None, None)),
+            "drop  ·  step 3 of 60  ·  load factor 0.05"
+        );
     }
 }

@@ -205,6 +205,7 @@ pub fn draw_frame(
             last_step: extent.last_step,
             load_factor: step.load_factor,
             time: step.time,
+            gif_slowdown: extent.gif_slowdown,
             max_displacement: facts.max_displacement,
             overloaded: facts.overloaded,
             broken: (facts.broken > 0 || step.bodies.iter().any(|b| b.fracture.is_some()))

@@ -178,6 +178,22 @@ fn draw_frames(
     mut report: RenderReport,
 ) -> Result<RenderReport, RenderError> {
     let final_png = dir.join("png");
+    // A dynamic run's frames show for their real time to the next (or a stated slow-down,
+    // which each frame's title then states).
+    let timing = if options.gif {
+        let times: Option<Vec<f64>> = steps
+            .iter()
+            .map(|&k| run.step(k).and_then(stored_time))
+            .collect();
+        times.and_then(|t| timed_delays(&t, LAST_FRAME_DELAY))
+    } else {
+        None
+    };
+    report.gif_slowdown = timing.as_ref().map(|(_, s)| *s);
+    let extent = &RunExtent {
+        gif_slowdown: report.gif_slowdown,
+        ..extent.clone()
+    };
     let draw = |k: usize| -> Result<Frame, RenderError> {
         let result = run.step(k).ok_or_else(|| RenderError::NoSuchStep {
             step: k,
@@ -208,17 +224,6 @@ fn draw_frames(
     } else {
         None
     };
-    // A dynamic run's frames show for their real time to the next (or a stated slow-down).
-    let timing = if gif.is_some() {
-        let times: Option<Vec<f64>> = steps
-            .iter()
-            .map(|&k| run.step(k).and_then(stored_time))
-            .collect();
-        times.and_then(|t| timed_delays(&t, LAST_FRAME_DELAY))
-    } else {
-        None
-    };
-    report.gif_slowdown = timing.as_ref().map(|(_, s)| *s);
     let batch = (2 * rayon::current_num_threads()).max(4);
     let mut gif = gif;
     for (b, chunk) in steps.chunks(batch).enumerate() {
