@@ -9,7 +9,10 @@ fn build_lib() {
     use std::env;
     use std::path::PathBuf;
 
-    let vendor = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("vendor");
+    // Read when the script runs, not baked in when it is compiled: a target folder copied to
+    // another checkout then builds that checkout's sources.
+    let manifest = env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
+    let vendor = PathBuf::from(manifest).join("vendor");
     println!("cargo:rerun-if-changed={}", vendor.display());
 
     let mut build = cc::Build::new();
