@@ -4,7 +4,7 @@
 //! with its `table.csv`.
 
 use crate::render::plots::{plot_run, PlotError, WrittenPlot};
-use crate::render::report::write_report;
+use crate::render::report::write_report_of;
 use crate::scene::batch::{parse_table, TABLE};
 use crate::scene::{PlotSettings, RunResults, StoredRunError, Summary};
 use std::path::{Path, PathBuf};
@@ -61,7 +61,8 @@ pub fn redraw_plots(dir: &Path, out: &Path) -> Result<Vec<WrittenPlot>, ReplotEr
 
 /// Write the report again when the results folder `dir` is a job of a batch folder: the
 /// folder above it (or above its variant folder) holding the batch's `table.csv` with a row
-/// for it. Returns the batch page's path, or `None` when `dir` belongs to no batch folder.
+/// for it: the batch page and this job's page (the other jobs' pages are kept). Returns the
+/// batch page's path, or `None` when `dir` belongs to no batch folder.
 pub fn redraw_report(dir: &Path) -> Result<Option<PathBuf>, ReplotError> {
     let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
     for out in dir.ancestors().skip(1).take(2) {
@@ -80,7 +81,7 @@ pub fn redraw_report(dir: &Path) -> Result<Option<PathBuf>, ReplotError> {
         if !rows.iter().any(|r| r.job == job) {
             continue;
         }
-        let page = write_report(out, &rows).map_err(|e| ReplotError::Report {
+        let page = write_report_of(out, &rows, Some(&job)).map_err(|e| ReplotError::Report {
             path: out.join(crate::render::report::REPORT),
             message: e.to_string(),
         })?;

@@ -19,9 +19,15 @@ pub const REPORT: &str = "index.html";
 /// rows are read from their results) and `index.html` in each job's results folder, each
 /// atomically. Returns the batch page's path.
 pub fn write_report(out: &Path, rows: &[Row]) -> std::io::Result<PathBuf> {
+    write_report_of(out, rows, None)
+}
+
+/// [`write_report`], with the page of job `only` alone written again when it is given (the
+/// others kept as they are: `linkage render` of one job's folder).
+pub fn write_report_of(out: &Path, rows: &[Row], only: Option<&str>) -> std::io::Result<PathBuf> {
     let jobs: Vec<(&Row, JobFiles)> = rows.iter().map(|r| (r, JobFiles::find(out, r))).collect();
     for (row, files) in &jobs {
-        if !files.folder.is_empty() {
+        if !files.folder.is_empty() && only.is_none_or(|j| j == row.job) {
             let dir = files.dir(out);
             let viewer = viewer_of(&dir);
             write_atomically(
