@@ -246,8 +246,9 @@ enum Command {
 struct RenderArgs {
     /// A results folder written by `linkage run` (DIR/<scene name>).
     dir: PathBuf,
-    /// Write png/, anim.gif (and vtk/) into this folder instead of the results folder
-    /// (created if missing; its png/ then holds the frames of this drawing only).
+    /// Write png/, anim.gif, plots/ (and vtk/) into this folder instead of the results folder
+    /// (created if missing; its png/ then holds the frames of this drawing only). Without it
+    /// the report (index.html) of the batch folder holding DIR is written again too.
     #[arg(long)]
     out: Option<PathBuf>,
     /// Frame width, pixels.
@@ -865,6 +866,8 @@ fn render(a: &RenderArgs) -> Result<()> {
         gif: !a.no_gif,
         supersampling: a.supersampling,
         interrupt: Interrupt::on(&STOP),
+        // Read from the results folder's plot settings by `render_run_to`.
+        step_fraction: false,
     };
     let out = a.out.clone().unwrap_or_else(|| a.dir.clone());
     if a.out.is_some() {
@@ -922,6 +925,20 @@ fn render(a: &RenderArgs) -> Result<()> {
             files.len(),
             out.join("vtk").display()
         );
+    }
+    // The plots too, with the settings the run kept; the report when the folder is a job of
+    // a batch folder and is drawn in place.
+    let plots = linkage::render::redraw_plots(&a.dir, &out)?;
+    say!(
+        "drew {} plot{} in {}",
+        plots.len(),
+        if plots.len() == 1 { "" } else { "s" },
+        out.join(linkage::render::plots::PLOTS).display()
+    );
+    if a.out.is_none() {
+        if let Some(page) = linkage::render::redraw_report(&a.dir)? {
+            say!("report {}", page.display());
+        }
     }
     Ok(())
 }

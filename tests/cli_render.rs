@@ -101,6 +101,7 @@ fn run_png_vtk_then_render_again_with_other_options() {
             "anim.gif",
             "index.html",
             "model.json",
+            "plot_settings.json",
             "plots",
             "png",
             "steps",

@@ -248,3 +248,52 @@ fn the_glb_of_a_3d_contact_a_2d_and_a_fracture_scene_validates_with_a_target_per
         assert_eq!(doc["meshes"][0]["primitives"][0]["mode"], 1, "2D: lines");
     }
 }
+
+/// `q` (`[x, y, z, w]`) applied to `v`: v + 2w (q × v) + 2 q × (q × v).
+fn turn(q: &Value, v: [f64; 3]) -> [f64; 3] {
+    let q: Vec<f64> = q
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_f64().unwrap())
+        .collect();
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let axis = [q[0], q[1], q[2]];
+    let t = cross(axis, v).map(|c| 2.0 * c);
+    let u = cross(axis, t);
+    [0, 1, 2].map(|i| v[i] + q[3] * t[i] + u[i])
+}
+
+#[test]
+fn a_z_up_scene_stands_upright_in_the_glb() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = run(out.path(), "wedge_split", "");
+    let o = linkage()
+        .arg("render")
+        .arg(&dir)
+        .args(["--gltf", "--no-png", "--no-gif"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{o:?}");
+    let doc = glb_json(&std::fs::read(dir.join("anim.glb")).unwrap());
+    let nodes = doc["nodes"].as_array().unwrap();
+    // One root over every other node, turned so that the scene's up (+z) is glTF's +y.
+    let scene_nodes = doc["scenes"][0]["nodes"].as_array().unwrap();
+    assert_eq!(scene_nodes.len(), 1);
+    let root = &nodes[scene_nodes[0].as_u64().unwrap() as usize];
+    assert_eq!(root["children"].as_array().unwrap().len(), nodes.len() - 1);
+    let up = turn(&root["rotation"], [0.0, 0.0, 1.0]);
+    assert!(
+        up[0].abs() < 1e-6 && (up[1] - 1.0).abs() < 1e-6 && up[2].abs() < 1e-6,
+        "+z turns to {up:?}"
+    );
+    // A rotation: lengths kept, +x stays +x.
+    let x = turn(&root["rotation"], [1.0, 0.0, 0.0]);
+    assert!((x[0] - 1.0).abs() < 1e-6, "{x:?}");
+}

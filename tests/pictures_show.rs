@@ -282,6 +282,62 @@ fn a_frame_of_two_bodies_shows_each_in_its_own_colour() {
     let (ca, cb) = (centre(BODY_COLOURS[0]), centre(BODY_COLOURS[1]));
     let apart = ((ca.0 - cb.0).powi(2) + (ca.1 - cb.1).powi(2)).sqrt();
     assert!(apart > 60.0, "{ca:?} {cb:?}");
+    // The body colour is a rim: inside each disk (within 0.6 of its radius on screen) next to
+    // none of the body colour, and the members' stress colours show. The run's own stresses
+    // are near zero inside (grey); drawn with the left disk's members all in tension (red) and
+    // the right one's in compression (blue), the insides show red and blue.
+    let limit = ext.stress_limit;
+    let mut signed = results.steps.last().unwrap().clone();
+    for (b, sign) in signed.bodies.iter_mut().zip([0.8, -0.8]) {
+        b.stresses.iter_mut().for_each(|s| *s = sign * limit);
+    }
+    let coloured = draw_frame(&results.model, &signed, &ext, &o).unwrap();
+    let view = view_for(&o, &ext);
+    for (index, body) in results.model.bodies.iter().enumerate() {
+        let nodes: Vec<[f32; 3]> = body.nodes.iter().map(|p| view.project(&v3(p))).collect();
+        let n = nodes.len() as f32;
+        let c = nodes
+            .iter()
+            .fold([0.0f32; 2], |s, p| [s[0] + p[0] / n, s[1] + p[1] / n]);
+        let radius = nodes
+            .iter()
+            .map(|p| ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2)).sqrt())
+            .fold(0.0f32, f32::max);
+        assert!(radius > 40.0, "body {index}: {radius} pixels of radius");
+        let (mut inside, mut own, mut stress) = (0usize, 0usize, 0usize);
+        for y in 0..frame.height() {
+            for x in 0..frame.width() {
+                let d = ((x as f32 + 0.5 - c[0]).powi(2) + (y as f32 + 0.5 - c[1]).powi(2)).sqrt();
+                if d > 0.6 * radius {
+                    continue;
+                }
+                inside += 1;
+                if BODY_COLOURS
+                    .iter()
+                    .any(|&b| near(frame.rgb(x, y).unwrap(), b, 0.06))
+                {
+                    own += 1;
+                }
+                // Red (tension) in the left disk, blue (compression) in the right one.
+                let p = coloured.rgb(x, y).unwrap();
+                let warm = if index == 0 { p.0 - p.2 } else { p.2 - p.0 };
+                if warm > 0.25 {
+                    stress += 1;
+                }
+            }
+        }
+        eprintln!(
+            "body {index}: {inside} pixels inside, {own} of a body colour, {stress} of its stress colour"
+        );
+        assert!(
+            own * 100 < inside,
+            "body {index}: {own} of {inside} pixels of a body colour"
+        );
+        assert!(
+            stress * 20 > inside,
+            "body {index}: {stress} of {inside} pixels of its stress colour"
+        );
+    }
     // A single body keeps the plain look: none of the body colours.
     let mut one = results.model.clone();
     one.bodies.truncate(1);

@@ -352,6 +352,16 @@ fn the_report_opens_in_chromium_with_every_image_and_every_job() {
     assert!(images >= 8, "{images} images: {page}");
     let errors = browser.errors(&tab);
     assert!(errors.is_empty(), "index.html logged errors: {errors:?}");
+    // The table fits the page (no sideways scrolling in the default window).
+    let fit = browser.evaluate(
+        &tab,
+        "JSON.stringify([document.documentElement.scrollWidth, document.documentElement.clientWidth])",
+    );
+    assert!(fit[0].as_u64() <= fit[1].as_u64(), "page {fit} pixels wide");
+    // The failure is said once, its path relative to the batch folder (it can move).
+    let html = std::fs::read_to_string(&index).unwrap();
+    assert_eq!(html.matches("missing.toml").count(), 1, "{html}");
+    assert!(!html.contains(&out.path().display().to_string()), "{html}");
 
     // A scene's page: every frame, the plots, the animation, and the way back.
     let scene_page = out.path().join("disk_on_floor").join("index.html");

@@ -106,6 +106,11 @@ pub struct AnimatedRun {
     pub stored_steps: usize,
     /// Whether `frames` come from the steps' own times (a dynamic run).
     pub timed: bool,
+    /// What the frames' load factor is called: "load factor", or "step fraction" when it is
+    /// not what the schedules say ([`crate::scene::load_name`]; "load factor" unless set).
+    pub load_name: &'static str,
+    /// The unit direction that stands up (`model.json`'s `up`; `None`: +y).
+    pub up: Option<[Real; 3]>,
     /// Every body, in scene order.
     pub bodies: Vec<AnimatedBody>,
     /// Every obstacle, in scene order.
@@ -247,6 +252,8 @@ impl AnimatedRun {
             frames,
             stored_steps: run.steps.len(),
             timed,
+            load_name: crate::scene::load_name(false),
+            up: model.up,
             bodies,
             obstacles,
             stress_limit,

@@ -30,7 +30,7 @@ pub fn line_widths(body: &DeformedBody, view: &View, ui: f32) -> (f32, f32, f32)
 /// The members of a body as lines: the undeformed shape as a faint ghost behind, members
 /// coloured by axial stress (or plain), overloaded members black and thicker on top, as in
 /// the paper's Fig. 6; broken members are left out, so a crack shows as a gap, and marked
-/// by a short red line. `outline`: the body's own colour as a band under its members (frames
+/// by a short red line. `outline`: the body's own colour as a band under its rim (2D) or its members (frames
 /// of several bodies). Used for 2D bodies and for 3D bodies without patches (then drawn
 /// back to front).
 pub fn member_lines(

@@ -20,6 +20,7 @@ pub use self::options::{Colouring, Projection, RenderOptions, StepSelection};
 pub use self::picture::{camera_for, draw_frame, frame_primitives, view_for, viewport_for};
 pub use self::primitives::{paint, Layer, Mesh, MeshKind, Primitive};
 pub use self::raster::{Lighting, RasterVertex, Rasteriser, PLANE_ALPHA, VEIL_ALPHA};
+pub use self::replot::{read_summary, redraw_plots, redraw_report, ReplotError};
 pub use self::run_pictures::{
     draw_run, render_run, render_run_to, select_steps, PictureWriter, RenderReport,
 };
@@ -47,6 +48,7 @@ mod picture;
 pub mod plots;
 mod primitives;
 mod raster;
+mod replot;
 pub mod report;
 mod run_pictures;
 mod text;

@@ -131,6 +131,9 @@ pub struct RenderOptions {
     pub supersampling: u32,
     /// Stops the drawing between frames once raised (never by default).
     pub interrupt: Interrupt,
+    /// The results' load factor is the step fraction, not what the schedules say
+    /// ([`crate::scene::PlotSettings::step_fraction`]): the title calls it so.
+    pub step_fraction: bool,
 }
 
 impl Default for RenderOptions {
@@ -150,6 +153,7 @@ impl Default for RenderOptions {
             gif: true,
             supersampling: 2,
             interrupt: Interrupt::default(),
+            step_fraction: false,
         }
     }
 }

@@ -1,5 +1,6 @@
-//! Each body's own colour in frames of several bodies: a band under its members (line art)
-//! or its silhouette (shaded surfaces), so two bodies pressed together read as two.
+//! Each body's own colour in frames of several bodies: a band under its rim members (2D
+//! line art), under all its members (3D line art) or its silhouette (shaded surfaces), so two
+//! bodies pressed together read as two while the stress colours inside stay visible.
 
 use crate::render::colour_scale::BODY_COLOURS;
 use crate::render::deformed_body::DeformedBody;
@@ -12,14 +13,17 @@ pub fn body_colour(index: usize) -> Rgb {
 }
 
 /// The intact members of `body` as lines `width` pixels wide in `colour` under everything
-/// else ([`Layer::Behind`]): a band of the body's colour along the line art drawn on top.
+/// else ([`Layer::Behind`]): a band of the body's colour along the line art drawn on top. A
+/// 2D body gets it along its rim only ([`rim_members`]: its outline and the faces of its
+/// cracks), so its inside keeps the stress colours; a 3D body along all its members.
 pub fn member_band(body: &DeformedBody, colour: Rgb, width: f32) -> Vec<Primitive> {
+    let rim = (body.model.dimension == 2).then(|| rim_members(body));
     body.model
         .members
         .iter()
-        .zip(&body.broken)
-        .filter(|(_, broken)| !**broken)
-        .map(|(m, _)| Primitive::Line {
+        .enumerate()
+        .filter(|(j, _)| !body.broken[*j] && rim.as_ref().is_none_or(|r| r[*j]))
+        .map(|(_, m)| Primitive::Line {
             a: body.at(m[0]),
             b: body.at(m[1]),
             colour,
@@ -27,6 +31,56 @@ pub fn member_band(body: &DeformedBody, colour: Rgb, width: f32) -> Vec<Primitiv
             width,
             layer: Layer::Behind,
             depth_test: false,
+        })
+        .collect()
+}
+
+/// Whether each member of the 2D `body` lies on its rim: an intact member is inside when
+/// intact members close triangles with it on both of its sides (in the undeformed shape), on
+/// the rim otherwise (one side only, or no triangle: a bar of a truss). Broken members are
+/// not on the rim; the intact members along a crack are.
+pub fn rim_members(body: &DeformedBody) -> Vec<bool> {
+    let members = &body.model.members;
+    let n = body.undeformed.len();
+    let mut neighbours: Vec<Vec<usize>> = vec![Vec::new(); n];
+    let intact = |j: usize| !body.broken.get(j).copied().unwrap_or(false);
+    for (j, m) in members.iter().enumerate() {
+        let (a, b) = (m[0].wrapping_sub(1), m[1].wrapping_sub(1));
+        if intact(j) && a < n && b < n && a != b {
+            neighbours[a].push(b);
+            neighbours[b].push(a);
+        }
+    }
+    for list in &mut neighbours {
+        list.sort_unstable();
+        list.dedup();
+    }
+    members
+        .iter()
+        .enumerate()
+        .map(|(j, m)| {
+            let (a, b) = (m[0].wrapping_sub(1), m[1].wrapping_sub(1));
+            if !intact(j) || a >= n || b >= n {
+                return false;
+            }
+            let (pa, pb) = (body.undeformed[a], body.undeformed[b]);
+            let d = pb - pa;
+            let (mut left, mut right) = (false, false);
+            for &c in &neighbours[a] {
+                if c == b || neighbours[b].binary_search(&c).is_err() {
+                    continue;
+                }
+                let e = body.undeformed[c] - pa;
+                let side = d.x * e.y - d.y * e.x;
+                // A node on the member's own line closes no triangle.
+                let tiny = 1e-9 * d.norm_squared().max(e.norm_squared());
+                if side > tiny {
+                    left = true;
+                } else if side < -tiny {
+                    right = true;
+                }
+            }
+            !(left && right)
         })
         .collect()
 }

@@ -57,6 +57,9 @@ pub struct Caption {
     pub last_step: usize,
     /// Load factor of the step.
     pub load_factor: Real,
+    /// What the load factor is called: "load factor", or "step fraction" when it is not what
+    /// the schedules say ([`crate::scene::load_name`]).
+    pub load_name: &'static str,
     /// Time of the state drawn, s (a dynamic scene: the title shows it instead of the load
     /// factor).
     pub time: Option<Real>,
@@ -129,10 +132,11 @@ pub fn title(c: &Caption) -> String {
             )
         }
         None => format!(
-            "{}  ·  step {} of {}  ·  load factor {}",
+            "{}  ·  step {} of {}  ·  {} {}",
             c.scene,
             c.step,
             c.last_step,
+            c.load_name,
             fmt_load(c.load_factor)
         ),
     }

@@ -204,6 +204,7 @@ pub fn draw_frame(
             step: step.step,
             last_step: extent.last_step,
             load_factor: step.load_factor,
+            load_name: crate::scene::load_name(options.step_fraction),
             time: step.time,
             gif_slowdown: extent.gif_slowdown,
             max_displacement: facts.max_displacement,

@@ -10,7 +10,7 @@ use crate::render::{
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::publish::{publish_keeping, remove_stale, staging_dir};
 use crate::scene::MIN_STEP_DIGITS;
-use crate::scene::{DrawResults, RunResults, StoredRun, World};
+use crate::scene::{DrawResults, PlotSettings, RunResults, StoredRun, World};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -93,6 +93,10 @@ pub fn render_run_to(
     options: &RenderOptions,
 ) -> Result<RenderReport, RenderError> {
     options.check()?;
+    let options = &RenderOptions {
+        step_fraction: options.step_fraction || PlotSettings::read(dir).step_fraction,
+        ..options.clone()
+    };
     let stored = StoredRun::open(dir)?;
     // The selection is checked before the steps are read.
     select_steps(&stored, &options.steps)?;
@@ -297,6 +301,7 @@ impl DrawResults for PictureWriter {
     ) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
         let options = RenderOptions {
             interrupt: world.interrupt(),
+            step_fraction: world.plots.step_fraction,
             ..RenderOptions::from_settings(&world.pictures)
         };
         let drawn = draw_run(run, dir, &options)?;
@@ -313,6 +318,8 @@ impl DrawResults for PictureWriter {
         summary: &crate::scene::Summary,
         dir: &Path,
     ) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+        // Kept so that `linkage render` draws the same plots again.
+        world.plots.write(dir)?;
         crate::render::plots::plot_run(summary, run, &world.plots, dir)?;
         Ok(())
     }

@@ -390,7 +390,9 @@ fn build_world_from(
         contact.friction =
             friction_settings(c.get_ref(), &names, c.span()).map_err(|(span, e)| at(span, e))?;
     }
-    let plots = PlotSettings::from_spec(&spec.output, &bodies).map_err(|e| at(output_span, e))?;
+    let obstacle_names: Vec<&str> = obstacles.iter().map(|o| o.name.as_str()).collect();
+    let plots = PlotSettings::from_spec(&spec.output, &bodies, &obstacle_names)
+        .map_err(|e| at(output_span, e))?;
     let members = bodies.iter().map(|b| b.members.len()).sum();
     let output = OutputSettings {
         format: format.unwrap_or(ResultFormat::default_for(members)),

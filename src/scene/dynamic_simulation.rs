@@ -378,16 +378,8 @@ impl<'w> DynamicSimulation<'w> {
 /// The load factor reported at time `t` of `duration`: the common schedule's factor when every
 /// load and prescribed displacement follows one schedule, else `t / duration`.
 fn time_load_factor(world: &World, t: Real, duration: Real) -> Real {
-    let mut schedules = world.bodies.iter().flat_map(|b| {
-        b.loads.iter().map(|l| &l.schedule).chain(
-            b.supports
-                .iter()
-                .filter(|s| s.displacement.norm() > 0.0)
-                .map(|s| &s.schedule),
-        )
-    });
-    match schedules.next() {
-        Some(first) if schedules.all(|s| s == first) => time_factor(first, t, duration),
+    match crate::scene::world::common_schedule(&world.bodies) {
+        Some(first) => time_factor(first, t, duration),
         _ => t / duration,
     }
 }

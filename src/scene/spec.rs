@@ -593,6 +593,9 @@ pub struct OutputSpec {
     pub plot_node: Option<usize>,
     /// The body of `plot_node` (default: the first body).
     pub plot_body: Option<String>,
+    /// The obstacle whose push is the load: the load–displacement plot shows the force the
+    /// bodies receive from it against its travel.
+    pub plot_obstacle: Option<String>,
 }
 
 macro_rules! selector_of {

@@ -106,20 +106,12 @@ impl World {
     }
 
     /// The load factor reported for `step`: the common schedule's factor when every load and
-    /// prescribed displacement of the scene follows one schedule, else `step / steps`.
+    /// prescribed displacement of the scene follows one schedule ([`common_schedule`]), else
+    /// `step / steps` (the step fraction).
     pub fn load_factor(&self, step: usize) -> Real {
-        let mut schedules = self.bodies.iter().flat_map(|b| {
-            b.loads.iter().map(|l| &l.schedule).chain(
-                b.supports
-                    .iter()
-                    .filter(|s| s.displacement.norm() > 0.0)
-                    .map(|s| &s.schedule),
-            )
-        });
-        match schedules.next() {
-            Some(first) if schedules.all(|s| s == first) => first.factor(step, self.steps),
-            _ => Schedule::Linear.factor(step, self.steps),
-        }
+        common_schedule(&self.bodies)
+            .unwrap_or(&Schedule::Linear)
+            .factor(step, self.steps)
     }
 
     /// The model's size in one line, as `linkage check` prints it: bodies, nodes, members,
@@ -151,4 +143,20 @@ impl World {
             if self.steps == 1 { "" } else { "s" }
         )
     }
+}
+
+/// The one schedule every load and prescribed displacement of `bodies` follows; `None` when
+/// they follow different ones or there is none: the results' load factor is then the step
+/// fraction (`step / steps`, or `t / duration` in time), which pictures and plots call so.
+pub fn common_schedule(bodies: &[Body]) -> Option<&Schedule> {
+    let mut schedules = bodies.iter().flat_map(|b| {
+        b.loads.iter().map(|l| &l.schedule).chain(
+            b.supports
+                .iter()
+                .filter(|s| s.displacement.norm() > 0.0)
+                .map(|s| &s.schedule),
+        )
+    });
+    let first = schedules.next()?;
+    schedules.all(|s| s == first).then_some(first)
 }

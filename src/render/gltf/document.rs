@@ -246,8 +246,8 @@ pub fn gltf_of_run(run: &AnimatedRun) -> Vec<u8> {
             },
         },
         "scene": 0,
-        "scenes": [{"name": run.scene, "nodes": (0..nodes.len()).collect::<Vec<_>>()}],
-        "nodes": nodes,
+        "scenes": [{"name": run.scene, "nodes": [nodes.len()]}],
+        "nodes": nodes.iter().cloned().chain([standing(run.up, nodes.len())]).collect::<Vec<_>>(),
         "materials": [
             {"name": "bodies (vertex colours: member stress)", "doubleSided": true,
              "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 1.0],
@@ -271,4 +271,40 @@ pub fn gltf_of_run(run: &AnimatedRun) -> Vec<u8> {
     // The numbers come from result files checked finite when written (a NaN would become
     // null, which the validator reports).
     glb_bytes(doc.to_string().as_bytes(), &buf.bin)
+}
+
+/// The root node over the first `count` nodes: turned so that the run's `up` (`None`: +y)
+/// points along glTF's +y, so a z-up scene stands upright in Blender and on the web. The
+/// rotation is the quaternion [k sin(θ/2), cos(θ/2)] about k = up × y by θ = acos(up · y).
+pub fn standing(up: Option<[f64; 3]>, count: usize) -> Value {
+    let mut node = json!({"name": "linkage", "children": (0..count).collect::<Vec<_>>()});
+    if let Some(q) = up.and_then(rotation_to_y) {
+        node["rotation"] = json!(q);
+    }
+    node
+}
+
+/// The unit quaternion `[x, y, z, w]` turning the direction `up` onto +y; `None` when `up`
+/// is +y already (or not a direction).
+pub fn rotation_to_y(up: [f64; 3]) -> Option<[f32; 4]> {
+    let n = (up[0] * up[0] + up[1] * up[1] + up[2] * up[2]).sqrt();
+    if !(n > 0.0 && n.is_finite()) {
+        return None;
+    }
+    let u = up.map(|c| c / n);
+    // k = u × (0, 1, 0) = (-u_z, 0, u_x); cos θ = u_y.
+    let k = [-u[2], 0.0, u[0]];
+    let s = (k[0] * k[0] + k[2] * k[2]).sqrt();
+    if s < 1e-12 {
+        // Along ±y: nothing to turn, or half a turn about x.
+        return (u[1] < 0.0).then_some([1.0, 0.0, 0.0, 0.0]);
+    }
+    let theta = u[1].clamp(-1.0, 1.0).acos();
+    let (sin, cos) = ((theta / 2.0).sin(), (theta / 2.0).cos());
+    Some([
+        (k[0] / s * sin) as f32,
+        0.0,
+        (k[2] / s * sin) as f32,
+        cos as f32,
+    ])
 }

@@ -5,8 +5,9 @@ use crate::scene::Summary;
 
 /// The chart `breaks`: one point per break in the order they happened, at the load factor of
 /// the break and the number of members broken so far (all bodies); `None` without breaks. A
-/// softening member's teeth are not breaks: it counts when its last tooth breaks it.
-pub fn breaks(summary: &Summary) -> Option<Chart> {
+/// softening member's teeth are not breaks: it counts when its last tooth breaks it. `load`:
+/// what the load factor is called ([`crate::scene::load_name`]).
+pub fn breaks(summary: &Summary, load: &str) -> Option<Chart> {
     let broken: Vec<_> = summary
         .breaks
         .iter()
@@ -25,8 +26,8 @@ pub fn breaks(summary: &Summary) -> Option<Chart> {
     }
     Some(Chart {
         name: "breaks".into(),
-        title: format!("{}: members broken against load factor", summary.scene),
-        x_label: "load factor at the break (-)".into(),
+        title: format!("{}: members broken against {load}", summary.scene),
+        x_label: format!("{load} at the break (-)"),
         y_label: "members broken (count)".into(),
         columns: ("load_factor".into(), "broken_members".into()),
         log_y: false,

@@ -301,6 +301,10 @@ fn axis_tick(v: f64, biggest: f64, whole: bool) -> String {
     if whole && (v - v.round()).abs() > 1e-9 {
         return String::new();
     }
+    // A tick a round-off away from zero (the axis' ticks are multiples of a step, summed) is 0.
+    if v.abs() <= 1e-9 * biggest {
+        return "0".to_string();
+    }
     if v != 0.0 && !(1e-2..1e5).contains(&biggest) {
         return exponent(v);
     }
@@ -366,6 +370,13 @@ fn png_of(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tick_a_round_off_from_zero_reads_0() {
+        assert_eq!(axis_tick(-6.78e-21, 3.5e-4, false), "0");
+        assert_eq!(axis_tick(5e-5, 3.5e-4, false), "5e-5");
+        assert_eq!(axis_tick(1e-13, 1e-12, false), "1e-13");
+    }
 
     #[test]
     fn ticks_are_short_and_exact_enough() {

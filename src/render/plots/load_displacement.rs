@@ -7,7 +7,13 @@ use crate::scene::{PlotNode, RunResults, Summary};
 
 /// The chart `load_displacement`: one point per solved step (`node` = `None`, from the
 /// summary) or per stored step (`node`: its displacement magnitude, m, from the step results).
-pub fn load_displacement(summary: &Summary, run: &RunResults, node: Option<&PlotNode>) -> Chart {
+/// `load`: what the load factor is called ([`crate::scene::load_name`]).
+pub fn load_displacement(
+    summary: &Summary,
+    run: &RunResults,
+    node: Option<&PlotNode>,
+    load: &str,
+) -> Chart {
     let (series, x_label, column) = match node {
         None => {
             let mut s = Series::new("largest displacement");
@@ -47,9 +53,9 @@ pub fn load_displacement(summary: &Summary, run: &RunResults, node: Option<&Plot
     };
     Chart {
         name: "load_displacement".into(),
-        title: format!("{}: load factor against displacement", summary.scene),
+        title: format!("{}: {load} against displacement", summary.scene),
         x_label,
-        y_label: "load factor (-)".into(),
+        y_label: format!("{load} (-)"),
         columns: (column.into(), "load_factor".into()),
         log_y: false,
         legend: true,

@@ -1,13 +1,14 @@
 //! `DIR/index.html`: one row per job of the batch with its status, sizes, time, key results,
 //! plots and animation, each linked to its own page.
 
-use crate::render::report::facts::Facts;
+use crate::render::report::facts::{swept_value, Facts};
 use crate::render::report::html::{escape, link, page};
 use crate::render::report::job_files::JobFiles;
 use crate::scene::batch::Row;
 
-/// The batch page of `rows` (in batch order) with what each job left on disk.
-pub fn batch_page(title: &str, jobs: &[(&Row, JobFiles)]) -> String {
+/// The batch page of `rows` (in batch order) with what each job left on disk, and `after`
+/// (HTML: the sweep plots) below the table.
+pub fn batch_page(title: &str, jobs: &[(&Row, JobFiles)], after: &str) -> String {
     let mut body = format!(
         "<h1>{}</h1>\n<p class=\"note\">{} job{} of the batch; the table's numbers are in \
          <a href=\"batch.csv\">batch.csv</a>. Each scene's name opens its page with every \
@@ -25,6 +26,7 @@ pub fn batch_page(title: &str, jobs: &[(&Row, JobFiles)]) -> String {
         body.push_str(&job_row(row, files));
     }
     body.push_str("</tbody>\n</table>\n");
+    body.push_str(after);
     page(title, &body)
 }
 
@@ -36,7 +38,7 @@ fn job_row(row: &Row, files: &JobFiles) -> String {
         let values: Vec<String> = row
             .values
             .iter()
-            .map(|(k, v)| format!("{} = {}", escape(k), escape(v)))
+            .map(|(k, v)| format!("{} = {}", escape(k), escape(&swept_value(k, v))))
             .collect();
         name.push_str(&format!("<br><small>{}</small>", values.join("<br>")));
     }
@@ -118,7 +120,7 @@ mod tests {
             warnings: "deep & <wide>".into(),
             ..Row::default()
         };
-        let html = batch_page("batch <1>", &[(&row, JobFiles::default())]);
+        let html = batch_page("batch <1>", &[(&row, JobFiles::default())], "");
         for raw in ["a<b>", "<script>", "<1e-4>", "<wide>", "batch <1>"] {
             assert!(!html.contains(raw), "{raw} unescaped in {html}");
         }

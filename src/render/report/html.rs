@@ -48,8 +48,8 @@ body { font-family: system-ui, 'DejaVu Sans', Arial, sans-serif; margin: 1.5em; 
 h1 { font-size: 1.5em; margin-bottom: 0.2em; }
 h2 { font-size: 1.2em; margin-top: 1.5em; }
 p.note { color: #555; margin-top: 0; }
-table { border-collapse: collapse; }
-th, td { border: 1px solid #ccc; padding: 0.35em 0.55em; vertical-align: top; text-align: left; }
+table { border-collapse: collapse; width: 100%; }
+th, td { border: 1px solid #ccc; padding: 0.35em 0.55em; vertical-align: top; text-align: left; overflow-wrap: anywhere; }
 th { background: #f1f3f5; position: sticky; top: 0; }
 td.num { text-align: right; white-space: nowrap; font-variant-numeric: tabular-nums; }
 tr.ok td.status { color: #1b6e2a; font-weight: 600; }
@@ -58,11 +58,11 @@ tr.collapsed td.status { color: #a15c00; font-weight: 600; }
 ul.plain { list-style: none; padding: 0; margin: 0; }
 .warn { color: #a15c00; }
 .fail { color: #b00020; }
-td.plots { min-width: 330px; max-width: 340px; }
+td.plots { max-width: 340px; }
 td.size { white-space: nowrap; }
-td.results { min-width: 16em; }
-img.thumb { width: 160px; height: auto; border: 1px solid #ddd; margin: 1px; }
-img.anim { width: 220px; height: auto; border: 1px solid #ddd; }
+td.results { min-width: 12em; }
+img.thumb { width: 160px; max-width: 100%; height: auto; border: 1px solid #ddd; margin: 1px; }
+img.anim { width: 220px; max-width: 100%; height: auto; border: 1px solid #ddd; }
 td.status { max-width: 16em; }
 figure { display: inline-block; margin: 0.4em; vertical-align: top; }
 figure img { max-width: 100%; height: auto; border: 1px solid #ddd; }

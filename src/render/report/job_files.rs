@@ -21,6 +21,8 @@ pub struct JobFiles {
     pub plots: Vec<String>,
     /// Whether `anim.gif` is there.
     pub gif: bool,
+    /// The batch folder `DIR` (messages name paths relative to it).
+    pub batch: PathBuf,
 }
 
 /// The order plots are shown in (the order `plot_run` writes them); others after, by name.
@@ -50,7 +52,10 @@ impl JobFiles {
             .into_iter()
             .find(|s| !row.job.is_empty() && join(out, s).join("summary.json").is_file())
         else {
-            return JobFiles::default();
+            return JobFiles {
+                batch: out.to_path_buf(),
+                ..JobFiles::default()
+            };
         };
         let dir = join(out, &folder);
         let summary = std::fs::read(dir.join("summary.json"))
@@ -75,6 +80,7 @@ impl JobFiles {
             )
         });
         JobFiles {
+            batch: out.to_path_buf(),
             gif: dir.join("anim.gif").is_file(),
             folder,
             summary,

@@ -1,7 +1,7 @@
 //! `DIR/<job>/index.html`: one job's key results, its plots (with their SVG and data) and
 //! every frame.
 
-use crate::render::report::facts::Facts;
+use crate::render::report::facts::{swept_value, Facts};
 use crate::render::report::html::{escape, link, page};
 use crate::render::report::job_files::JobFiles;
 use crate::scene::batch::Row;
@@ -24,7 +24,10 @@ pub fn scene_page(row: &Row, files: &JobFiles, viewer: &str) -> String {
         format!("<span class=\"{}\">{}</span>", f.kind, f.status),
     )];
     for (k, v) in &row.values {
-        facts.push(("swept", format!("{} = {}", escape(k), escape(v))));
+        facts.push((
+            "swept",
+            format!("{} = {}", escape(k), escape(&swept_value(k, v))),
+        ));
     }
     facts.extend([
         ("size", f.size.clone()),

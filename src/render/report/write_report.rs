@@ -4,11 +4,12 @@ use crate::render::report::batch_page::batch_page;
 use crate::render::report::html::escape;
 use crate::render::report::job_files::JobFiles;
 use crate::render::report::scene_page::scene_page;
+use crate::render::report::sweep_plots::{sweep_section, write_sweep_plots};
 use crate::render::viewer::{viewer_data, viewer_section, VIEWER_BUDGET};
 use crate::render::{stored_time, AnimatedRun, RunExtent};
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::batch::Row;
-use crate::scene::RunResults;
+use crate::scene::{PlotSettings, RunResults};
 use std::path::{Path, PathBuf};
 
 /// The report's file name, in `DIR` and in each job's results folder.
@@ -18,9 +19,15 @@ pub const REPORT: &str = "index.html";
 /// rows are read from their results) and `index.html` in each job's results folder, each
 /// atomically. Returns the batch page's path.
 pub fn write_report(out: &Path, rows: &[Row]) -> std::io::Result<PathBuf> {
+    write_report_of(out, rows, None)
+}
+
+/// [`write_report`], with the page of job `only` alone written again when it is given (the
+/// others kept as they are: `linkage render` of one job's folder).
+pub fn write_report_of(out: &Path, rows: &[Row], only: Option<&str>) -> std::io::Result<PathBuf> {
     let jobs: Vec<(&Row, JobFiles)> = rows.iter().map(|r| (r, JobFiles::find(out, r))).collect();
     for (row, files) in &jobs {
-        if !files.folder.is_empty() {
+        if !files.folder.is_empty() && only.is_none_or(|j| j == row.job) {
             let dir = files.dir(out);
             let viewer = viewer_of(&dir);
             write_atomically(
@@ -42,8 +49,12 @@ pub fn write_report(out: &Path, rows: &[Row]) -> std::io::Result<PathBuf> {
         1..=4 => format!("linkage: {}", scenes.join(", ")),
         n => format!("linkage: {} and {} more", scenes[..3].join(", "), n - 3),
     };
+    let sweeps = write_sweep_plots(out, rows).map_err(std::io::Error::other)?;
     let path = out.join(REPORT);
-    write_atomically(&path, batch_page(&title, &jobs).as_bytes())?;
+    write_atomically(
+        &path,
+        batch_page(&title, &jobs, &sweep_section(&sweeps)).as_bytes(),
+    )?;
     Ok(path)
 }
 
@@ -54,7 +65,9 @@ fn viewer_of(dir: &Path) -> String {
     match RunResults::read(dir) {
         Ok(run) => {
             let magnification = RunExtent::of_run(&run, None).magnification;
-            let animation = AnimatedRun::of_run(&run, magnification, VIEWER_BUDGET, stored_time);
+            let mut animation =
+                AnimatedRun::of_run(&run, magnification, VIEWER_BUDGET, stored_time);
+            animation.load_name = PlotSettings::read(dir).load_name();
             viewer_section(&viewer_data(&animation))
         }
         Err(e) => format!(

@@ -147,19 +147,40 @@
   renderer.setSize(width, height);
   document.getElementById('viewer-canvas').appendChild(renderer.domElement);
 
+  // The scene's up (+y unless model.json says otherwise): the camera's x and z of a y-up
+  // scene are turned with it (the rotation taking +y onto up, Rodrigues' formula).
+  const up = (data.up || [0, 1, 0]).slice();
+  const upLength = Math.hypot(...up) || 1;
+  for (let k = 0; k < 3; k++) up[k] /= upLength;
+  const fromY = (v) => {
+    const axis = [up[2], 0, -up[0]]; // (0, 1, 0) × up
+    const s = Math.hypot(...axis);
+    const c = up[1];
+    if (s < 1e-12) return c > 0 ? v : [v[0], -v[1], -v[2]];
+    const k = axis.map((a) => a / s);
+    const kv = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+    const cross = [k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]];
+    return [0, 1, 2].map((i) => v[i] * c + cross[i] * s + k[i] * kv * (1 - c));
+  };
   let camera;
   if (data.is3d) {
     camera = new THREE.PerspectiveCamera(35, width / height, radius / 100, radius * 100);
     const az = 35 * Math.PI / 180;
     const el = 25 * Math.PI / 180;
     const d = 1.15 * radius / Math.sin(17.5 * Math.PI / 180);
-    camera.position.set(centre[0] + d * Math.sin(az) * Math.cos(el), centre[1] + d * Math.sin(el),
-      centre[2] + d * Math.cos(az) * Math.cos(el));
+    const ex = fromY([1, 0, 0]);
+    const ez = fromY([0, 0, 1]);
+    const along = [0, 1, 2].map((i) => d * (Math.sin(az) * Math.cos(el) * ex[i] +
+      Math.sin(el) * up[i] + Math.cos(az) * Math.cos(el) * ez[i]));
+    camera.up.set(up[0], up[1], up[2]);
+    camera.position.set(centre[0] + along[0], centre[1] + along[1], centre[2] + along[2]);
   } else {
     const half = 0.6 * Math.max(box.hi[0] - box.lo[0], (box.hi[1] - box.lo[1]) * width / height, 1e-9);
     const halfH = half * height / width;
     camera = new THREE.OrthographicCamera(-half, half, halfH, -halfH, -100 * size, 100 * size);
     camera.position.set(centre[0], centre[1], centre[2] + 4 * size);
+    // A 2D scene seen from +z, turned so that its up (in its plane) points up.
+    if (Math.abs(up[2]) < 1e-9) camera.up.set(up[0], up[1], 0);
   }
   scene.add(camera);
   scene.add(new THREE.AmbientLight(0xffffff, 1.6));
@@ -249,7 +270,7 @@
       o.mesh.visible = show.obstacles;
     });
     const f = data.frames[k];
-    const when = data.timed ? 't = ' + si(f.time, 's') : 'load factor ' + f.load_factor.toPrecision(3);
+    const when = data.timed ? 't = ' + si(f.time, 's') : (data.loadName || 'load factor') + ' ' + f.load_factor.toPrecision(3);
     document.getElementById('viewer-label').textContent =
       'step ' + f.step + ' (' + (k + 1) + ' of ' + n + '), ' + when;
     slider.value = String(k);
