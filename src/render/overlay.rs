@@ -462,6 +462,7 @@ mod tests {
             step: 3,
             last_step: 60,
             load_factor: 0.05,
+            load_name: "load factor",
             time,
             gif_slowdown,
             max_displacement: 0.0,
