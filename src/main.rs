@@ -895,7 +895,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         );
     }
     if a.gltf {
-        let run = RunResults::read(&a.dir)?;
+        let run = RunResults::read_until(&a.dir, Interrupt::on(&STOP))?;
         let g = write_gltf(&run, &out, report.magnification, stored_time)?;
         println!(
             "wrote {} ({} frame{} of {} stored step{}{}, displacements ×{})",
@@ -913,7 +913,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         );
     }
     if a.vtk {
-        let run = RunResults::read(&a.dir)?;
+        let run = RunResults::read_until(&a.dir, Interrupt::on(&STOP))?;
         let encoding = if a.vtk_ascii {
             VtkEncoding::Ascii
         } else {

@@ -901,6 +901,89 @@ fn absurd_step_counts_are_refused_before_anything_is_allocated() {
     assert!(left.is_empty(), "{left:?}");
 }
 
+/// Issue 33, item 4: a generator of 10⁹ cells is refused before anything is allocated, with
+/// the generator's key, its parameters, the counts, the memory estimate (at least 144 B per
+/// node and 56 B + d² · 16 B per member, `scene::fits_machine`) and what the machine has. By
+/// hand: 1000³ box cells make 1001³ ≈ 1.003e9 nodes and 1.301e10 members, at least 2.747e3 GB;
+/// 31623² rectangle cells make 1.000e9 nodes and 4.000e9 members, at least 6.240e2 GB.
+#[test]
+fn generators_of_a_billion_cells_are_refused_with_a_memory_estimate_before_allocating() {
+    let c = Case::new();
+    let body = |geometry: &str| {
+        format!(
+            "name = \"t\"\n{MATERIAL}\n[[bodies]]\nname = \"g\"\n{geometry}\n[[bodies.supports]]\nnodes = [1]\nfix = [\"x\", \"y\"]\n"
+        )
+    };
+    let cases = [
+        (
+            "box_lattice = { size = [1.0, 1.0, 1.0], cells = [1000, 1000, 1000] }",
+            vec![
+                "`box_lattice` with cells = [1000, 1000, 1000]",
+                "1.003e9 nodes",
+                "1.301e10 members",
+                "at least 2.747e3 GB of memory",
+            ],
+        ),
+        (
+            "rectangle = { width = 1.0, height = 1.0, cells = [31623, 31623] }",
+            vec![
+                "`rectangle` with cells = [31623, 31623]",
+                "1.000e9 nodes",
+                "4.000e9 members",
+                "at least 6.240e2 GB of memory",
+            ],
+        ),
+        (
+            "disk = { radius = 1.0, rings = 31623, sectors = 31623 }",
+            vec!["`disk` with rings = 31623, sectors = 31623", "GB of memory"],
+        ),
+        (
+            "cylindrical_shell = { radius = 1.0, length = 1.0, rings = 31623, sectors = 31623 }",
+            vec![
+                "`cylindrical_shell` with rings = 31623, sectors = 31623",
+                "GB of memory",
+            ],
+        ),
+    ];
+    for (geometry, parts) in &cases {
+        let started = std::time::Instant::now();
+        let msg = scene_error(&c, &body(geometry));
+        assert!(started.elapsed().as_secs_f64() < 2.0, "{geometry}: slow");
+        assert_has(
+            &msg,
+            &[
+                "scene.toml:",
+                "body 'g'",
+                "GB available",
+                "give fewer cells",
+            ],
+        );
+        assert_has(&msg, parts);
+    }
+    // `linkage run` refuses it the same way and writes nothing.
+    let scene = c.dir.path().join("huge.toml");
+    std::fs::write(&scene, body(cases[0].0)).unwrap();
+    let out = c.dir.path().join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_linkage"))
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{stdout}");
+    assert_has(&stdout, &["huge.toml", "`box_lattice`", "GB of memory"]);
+    assert!(!out.join("t").exists());
+    // A size that fits is built as before.
+    std::fs::write(
+        &scene,
+        body("box_lattice = { size = [1.0, 1.0, 1.0], cells = [2, 2, 2] }"),
+    )
+    .unwrap();
+    assert!(load_scene(&scene).is_ok());
+}
+
 #[test]
 fn a_body_check_made_before_solving_points_at_the_key_not_the_body_header() {
     // Node 5 belongs to no member: the error is about the links, so it names the line of

@@ -506,3 +506,119 @@ fn sigterm_and_sigint_while_writing_vtk_exit_130_and_keep_the_old_vtk() {
         "run --vtk: vtk/ changed"
     );
 }
+
+/// Issue 33, item 2: a signal while a body is prepared from an outline stops the preparation
+/// (the refinement, one call of `spade`, runs on a thread of its own that the preparation
+/// stops waiting for): `linkage prepare` of a 2 m × 1 m plate at a spacing of 2 mm (about a
+/// million triangles, seconds of refinement) exits 130 within two seconds of the signal and
+/// writes nothing; `linkage run` of a scene with that outline exits 130 the same way, no
+/// staging folder, earlier results untouched.
+#[test]
+fn sigterm_and_sigint_while_preparing_an_outline_exit_130() {
+    let dir = tempfile::tempdir().unwrap();
+    let outline = dir.path().join("plate.txt");
+    std::fs::write(&outline, "0 0\n2 0\n2 1\n0 1\n").unwrap();
+    let prepared = dir.path().join("prepared");
+    for signal in [libc::SIGTERM, libc::SIGINT] {
+        let args: Vec<&std::ffi::OsStr> = vec![
+            "prepare".as_ref(),
+            outline.as_os_str(),
+            "--spacing".as_ref(),
+            "0.002".as_ref(),
+            "--out".as_ref(),
+            prepared.as_os_str(),
+        ];
+        let s = interrupt(&args, Duration::from_millis(500), signal);
+        assert_ne!(s.code, Some(-1), "prepare ended before signal {signal}");
+        assert_eq!(s.code, Some(130), "signal {signal}: {}", s.stderr);
+        assert!(
+            s.seconds < 2.0,
+            "signal {signal}: {:.2} s to stop",
+            s.seconds
+        );
+        assert!(
+            s.stderr.contains("interrupted while preparing"),
+            "{}",
+            s.stderr
+        );
+        let written = std::fs::read_dir(&prepared).map_or(0, |r| r.count());
+        assert_eq!(written, 0, "prepare wrote files after signal {signal}");
+    }
+    let scene = dir.path().join("outline_plate.toml");
+    std::fs::write(
+        &scene,
+        r#"name = "outline_plate"
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "plate"
+outline = { file = "plate.txt", spacing = 0.002 }
+[[bodies.supports]]
+on_line = { point = [0.0, 0.0], direction = [0.0, 1.0] }
+fix = ["x", "y"]
+"#,
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let earlier = earlier_results(dir.path(), &out, "outline_plate");
+    check_stops(&scene, &[], &out, "outline_plate", &earlier, &[0.5, 0.8]);
+}
+
+/// Issue 33, item 2: a signal while `linkage render` reads the stored results (21 steps of an
+/// 80,000-member plate, seconds to read) stops before the next step file: exit 130 within two
+/// seconds, the message says the reading was interrupted, the earlier `anim.glb` as it was.
+#[test]
+fn sigterm_and_sigint_while_render_reads_the_results_exit_130() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = plate_scene(dir.path());
+    let out = dir.path().join("out");
+    let o = linkage()
+        .args(["run".as_ref(), scene.as_os_str()])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let results = out.join("plate");
+    let glb = results.join("anim.glb");
+    let render = |results: &Path| {
+        let args: Vec<std::ffi::OsString> = vec![
+            "render".into(),
+            results.into(),
+            "--gltf".into(),
+            "--no-png".into(),
+            "--no-gif".into(),
+        ];
+        args
+    };
+    let o = linkage().args(render(&results)).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let earlier = std::fs::read(&glb).unwrap();
+    let args = render(&results);
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    for (k, signal) in [libc::SIGTERM, libc::SIGINT].into_iter().enumerate() {
+        let s = interrupt(&args, Duration::from_millis(300 + 300 * k as u64), signal);
+        let what = format!("render, signal {signal}");
+        assert_ne!(s.code, Some(-1), "{what}: ended before the signal");
+        assert_eq!(s.code, Some(130), "{what}: {}", s.stderr);
+        assert!(s.seconds < 2.0, "{what}: {:.2} s to stop", s.seconds);
+        assert!(
+            s.stderr
+                .contains("interrupted while reading the stored results"),
+            "{what}: {}",
+            s.stderr
+        );
+        assert_eq!(
+            std::fs::read(&glb).unwrap(),
+            earlier,
+            "{what}: anim.glb changed"
+        );
+        assert!(
+            hidden(&results).is_empty(),
+            "{what}: {:?}",
+            hidden(&results)
+        );
+    }
+}

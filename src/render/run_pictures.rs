@@ -100,7 +100,7 @@ pub fn render_run_to(
     let stored = StoredRun::open(dir)?;
     // The selection is checked before the steps are read.
     select_steps(&stored, &options.steps)?;
-    let run = stored.read_all()?;
+    let run = stored.read_all_until(options.interrupt)?;
     if out != dir {
         std::fs::create_dir_all(out).map_err(|source| RenderError::Write {
             path: out.to_path_buf(),

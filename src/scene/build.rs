@@ -923,6 +923,9 @@ fn build_body(
                 "`patches` goes with `nodes` and `links` files, not with a generator".to_string(),
             ));
         }
+        if let Some(why) = crate::scene::fits_machine::generator_refusal(spec) {
+            return Err(here(why));
+        }
         let prepared = prepared_geometry(spec, folder, stop).map_err(&here)?;
         let geometry: Geometry = if let Some(p) = prepared {
             notes.report = Some(p.report);

@@ -3,8 +3,12 @@
 //! is allocated, so that an absurd size (`steps = 4294967296`) is refused with a message
 //! instead of aborting on an allocation.
 
+use crate::linkage::generators::{
+    box_lattice_size, cylindrical_shell_size, disk_size, rectangle_size, GeneratedSize,
+};
 use crate::scene::check::{obstacle_offset_bytes, step_file_bytes, stored_steps};
 use crate::scene::results::StepSummary;
+use crate::scene::spec::BodySpec;
 use crate::scene::World;
 use std::path::Path;
 
@@ -89,6 +93,79 @@ pub fn refusal(world: &World, out: &Path, keeps_steps: bool) -> Option<String> {
     None
 }
 
+/// Bytes per node of a generated body, at the least, while it is built and solved: its
+/// position, displacement, force and reaction (4 × 3 × 8 B) and its degree-of-freedom slots
+/// (3 × 16 B).
+pub const BYTES_PER_NODE: u64 = 144;
+/// Bytes per member of a generated body, at the least, while it is built and solved, besides
+/// its stiffness entries: its end nodes as made (16 B), as a member with its material (24 B),
+/// and its force and strain (16 B).
+pub const BYTES_PER_MEMBER: u64 = 56;
+/// Bytes per stiffness entry (an 8 B value and an 8 B row index); a member adds d² entries
+/// (its two ends' cross block) for d = 2 or 3 directions per node. Fill-in of the
+/// factorization comes on top: the estimate is a lower bound.
+pub const BYTES_PER_STIFFNESS_ENTRY: u64 = 16;
+/// Bytes per boundary patch (its three nodes).
+pub const BYTES_PER_PATCH: u64 = 24;
+
+/// Bytes a generated body of `size` needs at the least to be built and solved, with `dofs`
+/// directions per node (2 or 3): `nodes · BYTES_PER_NODE + members · (BYTES_PER_MEMBER +
+/// dofs² · BYTES_PER_STIFFNESS_ENTRY) + patches · BYTES_PER_PATCH`. A float: an absurd size is
+/// beyond every integer type.
+pub fn generated_memory(size: &GeneratedSize, dofs: usize) -> f64 {
+    let d = dofs as f64;
+    size.nodes * BYTES_PER_NODE as f64
+        + size.members * (BYTES_PER_MEMBER as f64 + d * d * BYTES_PER_STIFFNESS_ENTRY as f64)
+        + size.patches * BYTES_PER_PATCH as f64
+}
+
+/// Why the body a generator would make cannot fit in `available` bytes of memory (`None`
+/// when it fits): the generator `key` (e.g. `"box_lattice"`), its `parameters` as written
+/// (e.g. `"cells = [1000, 1000, 1000]"`), the counts, the estimate and what to change.
+pub fn generated_refusal(
+    key: &str,
+    parameters: &str,
+    size: &GeneratedSize,
+    dofs: usize,
+    available: u64,
+) -> Option<String> {
+    let memory = generated_memory(size, dofs);
+    (memory > available as f64).then(|| {
+        format!(
+            "`{key}` with {parameters} would make {:.3e} nodes and {:.3e} members: building and solving them needs at least {:.3e} GB of memory, but the machine has {:.1} GB available: give fewer cells (the memory grows with the member count)",
+            size.nodes,
+            size.members,
+            memory / 1e9,
+            available as f64 / 1e9
+        )
+    })
+}
+
+/// Why the body `spec` generates (`disk`, `rectangle`, `cylindrical_shell`, `box_lattice`)
+/// cannot fit in the machine's available memory, checked before anything is allocated (see
+/// [`generated_refusal`]); `None` when it fits, when the body is not generated, or when the
+/// machine cannot be asked.
+pub fn generator_refusal(spec: &BodySpec) -> Option<String> {
+    let (key, parameters, size, dofs) = if let Some(g) = &spec.disk {
+        let p = format!("rings = {}, sectors = {}", g.rings, g.sectors);
+        ("disk", p, disk_size(g.rings, g.sectors), 2)
+    } else if let Some(g) = &spec.rectangle {
+        let p = format!("cells = [{}, {}]", g.cells[0], g.cells[1]);
+        ("rectangle", p, rectangle_size(g.cells[0], g.cells[1]), 2)
+    } else if let Some(g) = &spec.cylindrical_shell {
+        let p = format!("rings = {}, sectors = {}", g.rings, g.sectors);
+        let size = cylindrical_shell_size(g.rings, g.sectors);
+        ("cylindrical_shell", p, size, 3)
+    } else if let Some(g) = &spec.box_lattice {
+        let [x, y, z] = g.cells;
+        let p = format!("cells = [{x}, {y}, {z}]");
+        ("box_lattice", p, box_lattice_size(g.cells), 3)
+    } else {
+        return None;
+    };
+    generated_refusal(key, &parameters, &size, dofs, available_memory()?)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -100,5 +177,52 @@ mod tests {
         let disk = free_disk(Path::new(".")).expect("statvfs");
         assert!(disk > 0);
         assert!(free_disk(Path::new("/no/such/folder")).is_none());
+    }
+
+    /// The estimate by hand: a rectangle of 2 × 1 cells has 6 nodes and 11 members (4
+    /// horizontal, 3 vertical, 4 diagonal; 2D), so 6 · 144 + 11 · (56 + 4 · 16) = 864 + 1320
+    /// = 2184 B; a box lattice of one cell has 8
+    /// nodes, 28 members and 12 patches (3D): 8 · 144 + 28 · (56 + 9 · 16) + 12 · 24 =
+    /// 1152 + 5600 + 288 = 7040 B.
+    #[test]
+    fn the_generated_memory_is_counted_as_by_hand() {
+        use crate::linkage::generators::{box_lattice_size, rectangle_size};
+        assert_eq!(generated_memory(&rectangle_size(2, 1), 2), 2184.0);
+        assert_eq!(generated_memory(&box_lattice_size([1, 1, 1]), 3), 7040.0);
+        let size = box_lattice_size([1000, 1000, 1000]);
+        let why = generated_refusal(
+            "box_lattice",
+            "cells = [1000, 1000, 1000]",
+            &size,
+            3,
+            16 << 30,
+        )
+        .expect("1e9 cells do not fit in 16 GiB");
+        for part in [
+            "`box_lattice` with cells = [1000, 1000, 1000]",
+            "1.003e9 nodes",
+            "1.301e10 members",
+            "at least 2.747e3 GB of memory",
+            "the machine has 17.2 GB available",
+            "fewer cells",
+        ] {
+            assert!(why.contains(part), "{part:?} in {why}");
+        }
+        assert!(generated_refusal(
+            "box_lattice",
+            "cells = [1, 1, 1]",
+            &box_lattice_size([1, 1, 1]),
+            3,
+            7040
+        )
+        .is_none());
+        assert!(generated_refusal(
+            "box_lattice",
+            "cells = [1, 1, 1]",
+            &box_lattice_size([1, 1, 1]),
+            3,
+            7039
+        )
+        .is_some());
     }
 }

@@ -3,7 +3,7 @@
 //! paper's files of the result.
 
 use crate::contact::orient_outward;
-use crate::linkage::prepare::{prepare_mesh_until, prepare_outline, PreparedBody};
+use crate::linkage::prepare::{prepare_mesh_until, prepare_outline_until, PreparedBody};
 use crate::linkage::{Dimension, Interrupt};
 use crate::scene::mesh_file::read_mesh;
 use crate::scene::paper_files::{write_links, write_nodes, write_patches};
@@ -71,7 +71,7 @@ pub fn prepare_file(path: &Path, spacing: Real, stop: Interrupt) -> Result<Prepa
             .map_err(|e| format!("{}: {e}", path.display()))
     } else {
         let loops = read_outline(path)?;
-        prepare_outline(&loops, spacing).map_err(|e| format!("{}: {e}", path.display()))
+        prepare_outline_until(&loops, spacing, stop).map_err(|e| format!("{}: {e}", path.display()))
     }
 }
 
@@ -115,13 +115,15 @@ pub(crate) fn prepared_geometry(
         (Some(file), None) => {
             let path = folder.join(file);
             let loops = read_outline(&path).map_err(|e| format!("`outline`: {e}"))?;
-            prepare_outline(&loops, o.spacing)
+            prepare_outline_until(&loops, o.spacing, stop)
                 .map(Some)
                 .map_err(|e| format!("`outline` = {file:?}: {e}"))
         }
-        (None, Some(points)) => prepare_outline(std::slice::from_ref(points), o.spacing)
-            .map(Some)
-            .map_err(|e| format!("`outline`: {e}")),
+        (None, Some(points)) => {
+            prepare_outline_until(std::slice::from_ref(points), o.spacing, stop)
+                .map(Some)
+                .map_err(|e| format!("`outline`: {e}"))
+        }
         _ => Err("`outline` needs exactly one of `file` and `points`".to_string()),
     }
 }

@@ -1,6 +1,7 @@
 //! A results folder read back: `model.json` and the stored `steps/NNNN.json` (or `model.npz`
 //! and `steps/NNNN.npz`), checked against each other, for drawing and exporting a run without solving it again.
 
+use crate::linkage::Interrupt;
 use crate::scene::model_file::ModelFile;
 use crate::scene::npz_files::{read_model_npz, read_step_npz};
 use crate::scene::result_format::ResultFormat;
@@ -28,6 +29,12 @@ pub enum StoredRunError {
         path: PathBuf,
         /// What is wrong.
         problem: String,
+    },
+    /// Asked to stop (SIGINT, SIGTERM) while the steps were read: nothing was made of them.
+    #[error("{dir}: interrupted while reading the stored results: nothing was written")]
+    Interrupted {
+        /// The results folder.
+        dir: PathBuf,
     },
 }
 
@@ -208,8 +215,17 @@ impl StoredRun {
 
     /// Read every stored step into memory, each checked against the model and its file name.
     pub fn read_all(self) -> Result<RunResults, StoredRunError> {
+        self.read_all_until(Interrupt::default())
+    }
+
+    /// [`Self::read_all`], stopping before the next step file once `stop` is raised
+    /// ([`StoredRunError::Interrupted`]).
+    pub fn read_all_until(self, stop: Interrupt) -> Result<RunResults, StoredRunError> {
         let mut steps = Vec::with_capacity(self.steps.len());
         for &k in &self.steps {
+            if stop.is_raised() {
+                return Err(StoredRunError::Interrupted { dir: self.dir });
+            }
             let result = self.read_step(k)?;
             if result.step != k {
                 return Err(StoredRunError::Bad {
@@ -242,5 +258,11 @@ impl RunResults {
     /// [`StoredRun::read_all`].
     pub fn read(dir: &Path) -> Result<Self, StoredRunError> {
         StoredRun::open(dir)?.read_all()
+    }
+
+    /// [`Self::read`], stopping before the next step file once `stop` is raised
+    /// ([`StoredRunError::Interrupted`]).
+    pub fn read_until(dir: &Path, stop: Interrupt) -> Result<Self, StoredRunError> {
+        StoredRun::open(dir)?.read_all_until(stop)
     }
 }

@@ -1,6 +1,7 @@
 //! A box lattice: cubic cells whose nodes are joined to all their neighbours, and its boundary patches.
 
 use super::error::{allocate, check_count, check_length, sum_of_products};
+use super::size::Terms;
 use super::GeneratorError;
 use crate::linkage::{Dimension, Geometry};
 use crate::Real;
@@ -50,31 +51,13 @@ pub fn box_lattice(size: [Real; 3], cells: [usize; 3]) -> Result<Geometry, Gener
         check_count(SHAPE, parameter, value, 1)?;
     }
     let [nx, ny, nz] = cells;
-    // Saturating, so a count past usize::MAX is caught by the checked products below.
-    let [nx1, ny1, nz1] = cells.map(|n| n.saturating_add(1));
     let too_large = || format!("{cells:?}");
-    let mut nodes = allocate(
-        sum_of_products(&[&[nx1, ny1, nz1]]),
-        SHAPE,
-        "cells",
-        too_large,
-    )?;
-    let member_count = sum_of_products(&[
-        &[nx, ny1, nz1],
-        &[nx1, ny, nz1],
-        &[nx1, ny1, nz],
-        &[2, nx, ny, nz1],
-        &[2, nx, ny1, nz],
-        &[2, nx1, ny, nz],
-        &[4, nx, ny, nz],
-    ]);
+    let [nx1, ny1] = [nx.saturating_add(1), ny.saturating_add(1)];
+    let counts = terms(cells);
+    let mut nodes = allocate(sum_of_products(&counts.nodes), SHAPE, "cells", too_large)?;
+    let member_count = sum_of_products(&counts.members);
     let mut members = allocate(member_count, SHAPE, "cells", too_large)?;
-    let mut patches = allocate(
-        sum_of_products(&[&[4, ny, nz], &[4, nx, nz], &[4, nx, ny]]),
-        SHAPE,
-        "cells",
-        too_large,
-    )?;
+    let mut patches = allocate(sum_of_products(&counts.patches), SHAPE, "cells", too_large)?;
 
     for k in 0..=nz {
         let z = size[2] * (k as Real / nz as Real);
@@ -136,6 +119,26 @@ pub fn box_lattice(size: [Real; 3], cells: [usize; 3]) -> Result<Geometry, Gener
         members,
         patches,
     })
+}
+
+/// The node, member and patch counts of a box lattice of `cells`.
+pub(super) fn terms(cells: [usize; 3]) -> Terms {
+    let [nx, ny, nz] = cells;
+    // Saturating, so a count past usize::MAX is caught by the checked products.
+    let [nx1, ny1, nz1] = cells.map(|n| n.saturating_add(1));
+    Terms {
+        nodes: vec![vec![nx1, ny1, nz1]],
+        members: vec![
+            vec![nx, ny1, nz1],
+            vec![nx1, ny, nz1],
+            vec![nx1, ny1, nz],
+            vec![2, nx, ny, nz1],
+            vec![2, nx, ny1, nz],
+            vec![2, nx1, ny, nz],
+            vec![4, nx, ny, nz],
+        ],
+        patches: vec![vec![4, ny, nz], vec![4, nx, nz], vec![4, nx, ny]],
+    }
 }
 
 #[cfg(test)]

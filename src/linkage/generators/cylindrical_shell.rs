@@ -1,6 +1,7 @@
 //! The cylindrical shell of the paper's Fig. 7.
 
 use super::error::{allocate, check_count, check_length, sum_of_products};
+use super::size::Terms;
 use super::GeneratorError;
 use crate::linkage::{Dimension, Geometry};
 use crate::Real;
@@ -35,20 +36,21 @@ pub fn cylindrical_shell(
     check_count(SHAPE, "rings", rings, 2)?;
     check_count(SHAPE, "sectors", sectors, 3)?;
     let too_large = || format!("{rings}, {sectors}");
+    let counts = terms(rings, sectors);
     let mut nodes = allocate(
-        sum_of_products(&[&[rings, sectors]]),
+        sum_of_products(&counts.nodes),
         SHAPE,
         "rings, sectors",
         too_large,
     )?;
     let mut members = allocate(
-        sum_of_products(&[&[rings, sectors], &[3, rings - 1, sectors]]),
+        sum_of_products(&counts.members),
         SHAPE,
         "rings, sectors",
         too_large,
     )?;
     let mut patches = allocate(
-        sum_of_products(&[&[2, rings - 1, sectors]]),
+        sum_of_products(&counts.patches),
         SHAPE,
         "rings, sectors",
         too_large,
@@ -92,6 +94,16 @@ pub fn cylindrical_shell(
         members,
         patches,
     })
+}
+
+/// The node, member and patch counts of a cylindrical shell of `rings` and `sectors`.
+pub(super) fn terms(rings: usize, sectors: usize) -> Terms {
+    let cells = rings.saturating_sub(1);
+    Terms {
+        nodes: vec![vec![rings, sectors]],
+        members: vec![vec![rings, sectors], vec![3, cells, sectors]],
+        patches: vec![vec![2, cells, sectors]],
+    }
 }
 
 #[cfg(test)]

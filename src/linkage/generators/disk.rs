@@ -1,6 +1,7 @@
 //! The circular disk of the paper's Fig. 1.
 
 use super::error::{allocate, check_count, check_length, sum_of_products};
+use super::size::Terms;
 use super::GeneratorError;
 use crate::linkage::{Dimension, Geometry};
 use crate::Real;
@@ -26,14 +27,15 @@ pub fn disk(radius: Real, rings: usize, sectors: usize) -> Result<Geometry, Gene
     check_count(SHAPE, "rings", rings, 1)?;
     check_count(SHAPE, "sectors", sectors, 3)?;
     let too_large = || format!("{rings}, {sectors}");
+    let counts = terms(rings, sectors);
     let mut nodes = allocate(
-        sum_of_products(&[&[1], &[rings, sectors]]),
+        sum_of_products(&counts.nodes),
         SHAPE,
         "rings, sectors",
         too_large,
     )?;
     let mut members = allocate(
-        sum_of_products(&[&[2, sectors], &[4, rings - 1, sectors]]),
+        sum_of_products(&counts.members),
         SHAPE,
         "rings, sectors",
         too_large,
@@ -70,6 +72,15 @@ pub fn disk(radius: Real, rings: usize, sectors: usize) -> Result<Geometry, Gene
         members,
         patches: Vec::new(),
     })
+}
+
+/// The node and member counts of a disk of `rings` and `sectors`.
+pub(super) fn terms(rings: usize, sectors: usize) -> Terms {
+    Terms {
+        nodes: vec![vec![1], vec![rings, sectors]],
+        members: vec![vec![2, sectors], vec![4, rings.saturating_sub(1), sectors]],
+        patches: Vec::new(),
+    }
 }
 
 #[cfg(test)]

@@ -78,7 +78,7 @@ pub(super) fn check_count(
 }
 
 /// The sum of the products of `terms`, or `None` on overflow: the size of a list to allocate.
-pub(super) fn sum_of_products(terms: &[&[usize]]) -> Option<usize> {
+pub(super) fn sum_of_products(terms: &[Vec<usize>]) -> Option<usize> {
     terms.iter().try_fold(0usize, |sum, factors| {
         let product = factors.iter().try_fold(1usize, |p, &f| p.checked_mul(f))?;
         sum.checked_add(product)
@@ -126,8 +126,8 @@ mod tests {
 
     #[test]
     fn overflowing_sizes_are_an_error_not_an_abort() {
-        assert_eq!(sum_of_products(&[&[2, 3], &[4]]), Some(10));
-        assert_eq!(sum_of_products(&[&[usize::MAX, 2]]), None);
+        assert_eq!(sum_of_products(&[vec![2, 3], vec![4]]), Some(10));
+        assert_eq!(sum_of_products(&[vec![usize::MAX, 2]]), None);
         let r = allocate::<u8>(None, "box_lattice", "cells", || "[1, 2, 3]".into());
         assert!(r
             .unwrap_err()

@@ -6,6 +6,9 @@ pub use self::disk::disk;
 pub use self::error::GeneratorError;
 pub use self::loaded_lattice::{lattice_body, loaded_lattice};
 pub use self::rectangle::rectangle;
+pub use self::size::{
+    box_lattice_size, cylindrical_shell_size, disk_size, rectangle_size, GeneratedSize,
+};
 
 mod box_lattice;
 mod cylindrical_shell;
@@ -15,3 +18,4 @@ mod loaded_lattice;
 mod rectangle;
 #[cfg(test)]
 mod rigidity;
+mod size;

@@ -1,6 +1,7 @@
 //! The 2D rectangle of the paper's Fig. 4–6, cells with both diagonals.
 
 use super::error::{allocate, check_count, check_length, sum_of_products};
+use super::size::Terms;
 use super::GeneratorError;
 use crate::linkage::{Dimension, Geometry};
 use crate::Real;
@@ -28,17 +29,16 @@ pub fn rectangle(
     check_count(SHAPE, "cells_x", cells_x, 1)?;
     check_count(SHAPE, "cells_y", cells_y, 1)?;
     let (nx, ny) = (cells_x, cells_y);
-    // Saturating, so a count past usize::MAX is caught by the checked products below.
-    let (nx1, ny1) = (nx.saturating_add(1), ny.saturating_add(1));
     let too_large = || format!("{nx}, {ny}");
+    let counts = terms(nx, ny);
     let mut nodes = allocate(
-        sum_of_products(&[&[nx1, ny1]]),
+        sum_of_products(&counts.nodes),
         SHAPE,
         "cells_x, cells_y",
         too_large,
     )?;
     let mut members = allocate(
-        sum_of_products(&[&[nx, ny1], &[nx1, ny], &[2, nx, ny]]),
+        sum_of_products(&counts.members),
         SHAPE,
         "cells_x, cells_y",
         too_large,
@@ -69,6 +69,17 @@ pub fn rectangle(
         members,
         patches: Vec::new(),
     })
+}
+
+/// The node and member counts of a rectangle of `nx` × `ny` cells.
+pub(super) fn terms(nx: usize, ny: usize) -> Terms {
+    // Saturating, so a count past usize::MAX is caught by the checked products.
+    let (nx1, ny1) = (nx.saturating_add(1), ny.saturating_add(1));
+    Terms {
+        nodes: vec![vec![nx1, ny1]],
+        members: vec![vec![nx, ny1], vec![nx1, ny], vec![2, nx, ny]],
+        patches: Vec::new(),
+    }
 }
 
 #[cfg(test)]

@@ -4,7 +4,9 @@ pub use self::error::PrepareError;
 pub use self::mesh_body::{
     prepare_mesh, prepare_mesh_until, PreparedBody, MAX_SPACING_FRACTION, MEMORY_LIMIT,
 };
-pub use self::outline::{prepare_outline, MAX_TRIANGLES, MIN_TRIANGLE_ANGLE};
+pub use self::outline::{
+    prepare_outline, prepare_outline_until, MAX_TRIANGLES, MIN_TRIANGLE_ANGLE,
+};
 pub use self::quality::{dihedral_angles, enclosed_volume, PrepareReport};
 pub use self::stuffing::{ALPHA_LONG, ALPHA_SHORT};
 

@@ -5,7 +5,7 @@
 use super::mesh_body::PreparedBody;
 use super::quality::finish;
 use super::PrepareError;
-use crate::linkage::{Dimension, Geometry};
+use crate::linkage::{Dimension, Geometry, Interrupt};
 use crate::Real;
 use nalgebra::Vector3;
 use spade::{
@@ -134,6 +134,25 @@ pub fn prepare_outline(
     loops: &[Vec<[Real; 2]>],
     spacing: Real,
 ) -> Result<PreparedBody, PrepareError> {
+    prepare_outline_until(loops, spacing, Interrupt::default())
+}
+
+/// [`prepare_outline`], stopping with [`PrepareError::Interrupted`] once `stop` is raised:
+/// between the outline's segments and phases, and within 50 ms during the refinement, which
+/// `spade` does in one call: it runs on a thread of its own that is left to finish (its result
+/// dropped) when the stop comes. Uninterrupted, the body is the same.
+pub fn prepare_outline_until(
+    loops: &[Vec<[Real; 2]>],
+    spacing: Real,
+    stop: Interrupt,
+) -> Result<PreparedBody, PrepareError> {
+    let stopped = || {
+        if stop.is_raised() {
+            Err(PrepareError::Interrupted)
+        } else {
+            Ok(())
+        }
+    };
     if !(spacing.is_finite() && spacing > 0.0) {
         return Err(PrepareError::BadSpacing { spacing });
     }
@@ -170,6 +189,7 @@ pub fn prepare_outline(
     };
     let mut cdt = ConstrainedDelaunayTriangulation::<Point2<Real>>::new();
     for points in loops {
+        stopped()?;
         let mut handles = Vec::new();
         for i in 0..points.len() {
             let (a, b) = (points[i], points[(i + 1) % points.len()]);
@@ -185,13 +205,30 @@ pub fn prepare_outline(
             cdt.add_constraint(handles[i], handles[(i + 1) % handles.len()]);
         }
     }
-    let result = cdt.refine(
-        RefinementParameters::<Real>::new()
-            .with_angle_limit(AngleLimit::from_deg(MIN_TRIANGLE_ANGLE))
-            .with_max_allowed_area(AREA_FACTOR * equilateral)
-            .with_max_additional_vertices((4.0 * triangles) as usize + 1000)
-            .exclude_outer_faces(true),
-    );
+    stopped()?;
+    let parameters = RefinementParameters::<Real>::new()
+        .with_angle_limit(AngleLimit::from_deg(MIN_TRIANGLE_ANGLE))
+        .with_max_allowed_area(AREA_FACTOR * equilateral)
+        .with_max_additional_vertices((4.0 * triangles) as usize + 1000)
+        .exclude_outer_faces(true);
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let result = cdt.refine(parameters);
+        // The receiver is gone when the preparation was interrupted: nothing to hand over.
+        let _ = send.send((cdt, result));
+    });
+    let (cdt, result) = loop {
+        match receive.recv_timeout(std::time::Duration::from_millis(50)) {
+            Ok(refined) => break refined,
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => stopped()?,
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(PrepareError::Outline(
+                    "the refinement of the triangulation failed (spade panicked): smooth the outline or change the spacing".to_string(),
+                ))
+            }
+        }
+    };
+    stopped()?;
     if !result.refinement_complete {
         return Err(PrepareError::Outline(format!(
             "refinement to {MIN_TRIANGLE_ANGLE}° did not finish: an input corner is too sharp or two loops are too close for spacing {spacing} m; give a smaller spacing or smooth the outline"
