@@ -24,6 +24,16 @@
 //! body with large displacements gets the midpoint rule's forces (not exactly conservative).
 //! Mass-proportional damping enters the inertia term (`(c + α c_v) M`); stiffness-proportional
 //! damping is not supported with contact (the scene is refused).
+//!
+//! # Breaking members
+//!
+//! A world with breaking bodies solves each clock step through
+//! [`BreakingBodies::solve_trial_step`](crate::scene::BreakingBodies::solve_trial_step) with
+//! [`ContactTrialSteps`]: every trial sub-step of the event search is a [`DynamicContact::solve`]
+//! from the state [`DynamicContact::save`] took at the step's start (or the event's), put back
+//! by [`DynamicContact::restore`] before the next trial. [`DynamicContact::solve`] copies the
+//! broken members' modulus factors into the solver's bodies first. The contract and the energy
+//! bookkeeping are in `src/scene/dynamic_fracture.rs`.
 
 use crate::contact::{
     penetration_tolerance, ContactError, ContactSolver, NodeContact, Obstacle, TimeStepState,
