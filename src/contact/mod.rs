@@ -21,6 +21,7 @@ pub use self::settings::ContactSettings;
 pub use self::settle::ContactSolver;
 pub use self::start::StartOverlap;
 pub use self::surface::{cut_by_z0, obstacle_surface, Surface};
+pub use self::time_step::TimeStepState;
 
 mod boundary;
 mod condensed;

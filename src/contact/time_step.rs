@@ -44,12 +44,15 @@
 //! penalty work. The scene tests of `tests/dynamic_contact.rs` measure it: a bar bouncing off
 //! a wall keeps its energy to 1e-3 (2.2e-4 measured).
 
+use crate::contact::contact_set::{ActiveContact, ContactSet};
+use crate::contact::friction::FrictionHistory;
 use crate::contact::report::ContactStep;
 use crate::contact::{ContactError, ContactSettings, ContactSolver, Obstacle};
 use crate::linkage::dynamics::InertiaTerm;
 use crate::linkage::Body;
 use crate::Real;
 use nalgebra::Vector3;
+use std::collections::HashMap;
 
 impl ContactSolver {
     /// The solver of a dynamic world: the bodies of [`ContactSolver::new`], to be solved by
@@ -166,6 +169,55 @@ impl ContactSolver {
                 Err(e)
             }
         }
+    }
+}
+
+/// What a solved time step changes in a [`ContactSolver`]: the displacements it starts the
+/// next step from, the contact set and its normals, friction's committed history (stick
+/// anchors, slips), the step count and pseudo-time, and the force floor. Saved by
+/// [`ContactSolver::time_step_state`] and put back by
+/// [`ContactSolver::restore_time_step_state`], a solved time step is undone exactly: the next
+/// one solves as if it had never been (the event search of a breaking step tries several
+/// lengths of one sub-step from the same state).
+#[derive(Clone, Debug)]
+pub struct TimeStepState {
+    u: Vec<Vec<Real>>,
+    active: ContactSet,
+    normals: HashMap<ActiveContact, Vector3<Real>>,
+    friction: Option<FrictionHistory>,
+    time_steps: usize,
+    time_at: Real,
+    largest_force_scale: Real,
+}
+
+impl ContactSolver {
+    /// The state the next time step starts from (see [`TimeStepState`]).
+    pub fn time_step_state(&self) -> TimeStepState {
+        TimeStepState {
+            u: self.parts.iter().map(|p| p.u.clone()).collect(),
+            active: self.active.clone(),
+            normals: self.normals.clone(),
+            friction: self.friction.clone(),
+            time_steps: self.time_steps,
+            time_at: self.time_at,
+            largest_force_scale: self.largest_force_scale,
+        }
+    }
+
+    /// Go back to a state saved by [`ContactSolver::time_step_state`] of this solver. The
+    /// crossings into sharp obstacle features found since are forgotten (the next time step
+    /// records them anew from the restored positions).
+    pub fn restore_time_step_state(&mut self, saved: TimeStepState) {
+        for (p, u) in self.parts.iter_mut().zip(saved.u) {
+            p.u = u;
+        }
+        self.active = saved.active;
+        self.normals = saved.normals;
+        self.friction = saved.friction;
+        self.time_steps = saved.time_steps;
+        self.time_at = saved.time_at;
+        self.largest_force_scale = saved.largest_force_scale;
+        self.geometry.forget_crossings_found();
     }
 }
 

@@ -24,12 +24,25 @@
 //! body with large displacements gets the midpoint rule's forces (not exactly conservative).
 //! Mass-proportional damping enters the inertia term (`(c + α c_v) M`); stiffness-proportional
 //! damping is not supported with contact (the scene is refused).
+//!
+//! # Breaking members
+//!
+//! A world with breaking bodies solves each clock step through
+//! [`BreakingBodies::solve_trial_step`](crate::scene::BreakingBodies::solve_trial_step) with
+//! [`ContactTrialSteps`]: every trial sub-step of the event search is a [`DynamicContact::solve`]
+//! from the state [`DynamicContact::save`] took at the step's start (or the event's), put back
+//! by [`DynamicContact::restore`] before the next trial. [`DynamicContact::solve`] copies the
+//! broken members' modulus factors into the solver's bodies first. The contract and the energy
+//! bookkeeping are in `src/scene/dynamic_fracture.rs`.
 
-use crate::contact::{penetration_tolerance, ContactError, ContactSolver, NodeContact, Obstacle};
+use crate::contact::{
+    penetration_tolerance, ContactError, ContactSolver, NodeContact, Obstacle, TimeStepState,
+};
 use crate::linkage::dynamics::{
     time_factor, BodyMotion, InertiaTerm, Integrator, TimeStepFailure, TimeStepReport,
 };
 use crate::linkage::{Body, PhaseTimes, Schedule};
+use crate::scene::dynamic_fracture::TrialSteps;
 use crate::scene::results::{BodyResult, PairForce, StepSummary};
 use crate::scene::run_error::RunError;
 use crate::scene::simulation::contact_forces;
@@ -147,6 +160,13 @@ impl DynamicContact {
         (t0, h, may_cut): (Real, Real, bool),
     ) -> Result<ContactTimeStep, (usize, TimeStepFailure)> {
         let duration = self.duration;
+        // Members broken so far (modulus factor 0) reach the bodies the contact solver
+        // assembles; nothing else of a body changes in time.
+        for (mine, given) in self.bodies.iter_mut().zip(world_bodies) {
+            if mine.member_factors != given.member_factors {
+                mine.member_factors.clone_from(&given.member_factors);
+            }
+        }
         let forms: Vec<_> = motions
             .iter()
             .map(|m| integrator.form(&m.motion, &m.mass, h))
@@ -286,6 +306,91 @@ impl DynamicContact {
         self.sticking = solved.sticking;
         self.slipping = solved.slipping;
         Ok(out)
+    }
+}
+
+/// What a time step changes in a [`DynamicContact`]: the contact solver's state
+/// ([`TimeStepState`]) and the bookkeeping carried to the next step (committed slips, the last
+/// depth, the contacts and forces reported, the penalty energy).
+#[derive(Clone)]
+pub struct DynamicContactState {
+    solver: TimeStepState,
+    last_depth: Real,
+    slips: HashMap<(usize, usize, String), Vector3<Real>>,
+    contacts: Vec<Vec<NodeContact>>,
+    totals: Vec<Vec<(String, Vector3<Real>)>>,
+    sticking: usize,
+    slipping: usize,
+    penalty_energy: Real,
+}
+
+impl DynamicContact {
+    /// The state the next time step starts from.
+    pub fn save(&self) -> DynamicContactState {
+        DynamicContactState {
+            solver: self.solver.time_step_state(),
+            last_depth: self.last_depth,
+            slips: self.slips.clone(),
+            contacts: self.contacts.clone(),
+            totals: self.totals.clone(),
+            sticking: self.sticking,
+            slipping: self.slipping,
+            penalty_energy: self.penalty_energy,
+        }
+    }
+
+    /// Go back to a state saved by [`DynamicContact::save`]: the time steps solved since are
+    /// undone.
+    pub fn restore(&mut self, saved: DynamicContactState) {
+        self.solver.restore_time_step_state(saved.solver);
+        self.last_depth = saved.last_depth;
+        self.slips = saved.slips;
+        self.contacts = saved.contacts;
+        self.totals = saved.totals;
+        self.sticking = saved.sticking;
+        self.slipping = saved.slipping;
+        self.penalty_energy = saved.penalty_energy;
+    }
+}
+
+/// The contact time steps of one clock step as the event search of breaking members takes
+/// them ([`TrialSteps`]): each sub-step solved by [`DynamicContact::solve`], its contact counts
+/// recorded in the frame's summary line; a sub-step undone takes back its largest penetration
+/// (its contact iterations stay counted: they were done).
+pub struct ContactTrialSteps<'a> {
+    /// The contact solver.
+    pub contact: &'a mut DynamicContact,
+    /// The bodies' integrator.
+    pub integrator: &'a dyn Integrator,
+    /// Whether a step too deep may fail (to be halved): not at the smallest step.
+    pub may_cut: bool,
+    /// The summary line of the frame the step belongs to.
+    pub summary: &'a mut StepSummary,
+}
+
+impl TrialSteps for ContactTrialSteps<'_> {
+    type Saved = (DynamicContactState, Real);
+    const OTHER_FORCES: bool = true;
+
+    fn solve(
+        &mut self,
+        motions: &mut [BodyMotion],
+        bodies: &[Body],
+        t0: Real,
+        h: Real,
+    ) -> Result<Vec<TimeStepReport>, (usize, TimeStepFailure)> {
+        self.contact
+            .solve(motions, bodies, self.integrator, (t0, h, self.may_cut))
+            .map(|s| s.record(self.summary))
+    }
+
+    fn save(&self) -> Self::Saved {
+        (self.contact.save(), self.summary.max_penetration)
+    }
+
+    fn restore(&mut self, (contact, penetration): Self::Saved) {
+        self.contact.restore(contact);
+        self.summary.max_penetration = penetration;
     }
 }
 

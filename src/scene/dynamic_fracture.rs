@@ -26,12 +26,39 @@
 //! A sub-step that cannot be solved restores every motion and every member broken in the step
 //! and returns the failure: the clock halves the whole step as for any failed step.
 //!
-//! The search asks only for "solve the step from the saved state over a given length": a
-//! contact time step can use [`BreakingBodies::solve_step`] unchanged by passing its own solve
-//! (the contact solver's time step, with its contact state saved and restored with the
-//! motions) as `solve`.
+//! # With contact
+//!
+//! The search asks only for "solve the step from the saved state over a given length", and for
+//! a solver that keeps state between steps, for a way to save and restore it ([`TrialSteps`],
+//! [`BreakingBodies::solve_trial_step`]). The contact time step
+//! (`ContactTrialSteps` in `src/scene/dynamic_contact.rs`) saves with the motions everything a
+//! time step changes in the contact solver: the displacements the next step starts from, the
+//! contact set and its normals, friction's committed history (stick anchors and slips, so a
+//! retried sub-step slips from the same anchors and dissipates `μ f_N |Δslip|` once), the step
+//! count and pseudo-time, the committed slips and penalty energy of the energy bookkeeping.
+//! Each trial sub-step of the search starts from that state; the state at the bracket's end is
+//! saved with the motions there. So the sub-steps that make up a step are exactly the time
+//! steps of lengths `θ h, (1 − θ) h` of the contact solver, and a step in which nothing breaks
+//! is the contact step itself, bit for bit.
+//!
+//! The contact solver assembles its own copies of the bodies: the modulus factors of the broken
+//! members are copied to them before every sub-step, and its tangent is refactored at the first
+//! Newton iteration of every solve (a factor is reused only within one solve), so nothing
+//! stale survives a break. A break changes no position: the contacts at the event are those
+//! of the intact body, and a piece cut loose keeps its mass and its contacts (it may rest on,
+//! slide along or fly off what it touches). With contact, Newmark's and generalized-α's
+//! acceleration is not rebalanced on loads and members alone (that would drop the contact
+//! forces at the event) but shifted by the member forces lost: `a ← a + M⁻¹ (f_int,before(u)
+//! − f_int,after(u))` at the free DOFs, which for Newmark (balanced at the step's end) is the
+//! balance of the weakened body with its contact forces.
+//!
+//! Energy: the break removes the broken members' strain energy at the event from `strain` and
+//! adds it to `dissipated` (the penalty energy is unchanged: no position moves), so the
+//! balance `kinetic + strain + contact − work + dissipated` is that of the contact steps
+//! before and after, which `energy_momentum` keeps exactly against planes while the contact
+//! set holds within a step (see `src/contact/time_step.rs`).
 
-use crate::linkage::body_state::member_response_at;
+use crate::linkage::body_state::{internal_forces, member_response_at};
 use crate::linkage::dynamics::{
     strain_energy, BodyMotion, Motion, TimeStepFailure, TimeStepReport,
 };
@@ -81,6 +108,51 @@ pub type StepSolve<'a> = dyn FnMut(
         Real,
     ) -> Result<Vec<TimeStepReport>, (usize, TimeStepFailure)>
     + 'a;
+
+/// What the event search needs of a time step's solve that keeps its own state between steps
+/// (the contact solver: its contact set, friction history, penalty energy): the solve, and a
+/// way to save that state and put it back, so a trial sub-step that was solved can be undone.
+pub trait TrialSteps {
+    /// The solver's state besides the motions.
+    type Saved: Clone;
+    /// Whether forces act that the bodies alone do not give (contact): a break then shifts
+    /// Newmark's and generalized-α's acceleration by the member forces lost, `Δa = M⁻¹ Δf_int`,
+    /// instead of rebalancing it on the loads and members alone.
+    const OTHER_FORCES: bool;
+    /// Solve one (sub-)step of all bodies from `t0` over `h` (s) from the motions' state: on
+    /// success every motion is at `t0 + h`; on failure the motions and the solver's state are
+    /// as before the call.
+    fn solve(
+        &mut self,
+        motions: &mut [BodyMotion],
+        bodies: &[Body],
+        t0: Real,
+        h: Real,
+    ) -> Result<Vec<TimeStepReport>, (usize, TimeStepFailure)>;
+    /// The solver's state now.
+    fn save(&self) -> Self::Saved;
+    /// Put the solver back in a saved state.
+    fn restore(&mut self, saved: Self::Saved);
+}
+
+/// A closure ([`StepSolve`]) that keeps nothing between steps, as [`TrialSteps`].
+struct Stateless<'s, 'a>(&'s mut StepSolve<'a>);
+
+impl TrialSteps for Stateless<'_, '_> {
+    type Saved = ();
+    const OTHER_FORCES: bool = false;
+    fn solve(
+        &mut self,
+        motions: &mut [BodyMotion],
+        bodies: &[Body],
+        t0: Real,
+        h: Real,
+    ) -> Result<Vec<TimeStepReport>, (usize, TimeStepFailure)> {
+        (self.0)(motions, bodies, t0, h)
+    }
+    fn save(&self) {}
+    fn restore(&mut self, _: ()) {}
+}
 
 impl BreakingBodies {
     /// The breaking members of `bodies`, or `None` when no member breaks. Softening members
@@ -181,7 +253,21 @@ impl BreakingBodies {
         (t0, h, duration): (Real, Real, Real),
         rebalance: bool,
     ) -> Result<Vec<TimeStepReport>, (usize, TimeStepFailure)> {
+        self.solve_trial_step(motions, &mut Stateless(solve), (t0, h, duration), rebalance)
+    }
+
+    /// [`BreakingBodies::solve_step`] with a solver that keeps its own state between steps
+    /// ([`TrialSteps`]): that state is saved with the motions before each trial sub-step and
+    /// put back with them when the search tries another length, and when the step fails.
+    pub fn solve_trial_step<S: TrialSteps>(
+        &mut self,
+        motions: &mut [BodyMotion],
+        solver: &mut S,
+        (t0, h, duration): (Real, Real, Real),
+        rebalance: bool,
+    ) -> Result<Vec<TimeStepReport>, (usize, TimeStepFailure)> {
         let saved_motions: Vec<Motion> = motions.iter().map(|m| m.motion.clone()).collect();
+        let saved_solver = solver.save();
         let saved_factors: Vec<Vec<Real>> = self
             .bodies
             .iter()
@@ -193,12 +279,13 @@ impl BreakingBodies {
             .zip(&self.pending)
             .map(|(b, p)| (b.len(), p.len()))
             .collect();
-        let result = self.breaking_step(motions, solve, (t0, h, duration), rebalance);
+        let result = self.breaking_step(motions, solver, (t0, h, duration), rebalance);
         if result.is_err() {
             for (m, s) in motions.iter_mut().zip(saved_motions) {
                 m.motion = s;
                 m.forget_factor();
             }
+            solver.restore(saved_solver);
             for (k, body) in self.bodies.iter_mut().enumerate() {
                 body.member_factors = saved_factors[k].clone();
                 self.broken[k].truncate(saved_counts[k].0);
@@ -208,10 +295,10 @@ impl BreakingBodies {
         result
     }
 
-    fn breaking_step(
+    fn breaking_step<S: TrialSteps>(
         &mut self,
         motions: &mut [BodyMotion],
-        solve: &mut StepSolve<'_>,
+        solver: &mut S,
         (t0, h, duration): (Real, Real, Real),
         rebalance: bool,
     ) -> Result<Vec<TimeStepReport>, (usize, TimeStepFailure)> {
@@ -229,13 +316,20 @@ impl BreakingBodies {
         loop {
             let rest = end - t;
             let start: Vec<Motion> = motions.iter().map(|m| m.motion.clone()).collect();
+            let start_solver = solver.save();
             let s_start = self.stresses(motions);
-            let reports = solve(motions, &self.bodies, t, rest)?;
+            let reports = solver.solve(motions, &self.bodies, t, rest)?;
             let s_end = self.stresses(motions);
             if self.worst(&s_end) <= 1.0 + AT_STRENGTH {
                 add(&mut total, reports);
                 if self.worst(&s_end) >= 1.0 - AT_STRENGTH {
-                    self.break_at_strength(motions, &s_end, end, duration, &mut total, rebalance);
+                    self.break_at_strength::<S>(
+                        motions,
+                        &s_end,
+                        (end, duration),
+                        &mut total,
+                        rebalance,
+                    );
                 }
                 return Ok(total);
             }
@@ -243,8 +337,11 @@ impl BreakingBodies {
             let (mut lo, mut slo) = (0.0, s_start);
             let mut hi = 1.0;
             let mut shi = s_end;
-            let mut at_hi: (Vec<Motion>, Vec<TimeStepReport>) =
-                (motions.iter().map(|m| m.motion.clone()).collect(), reports);
+            let mut at_hi: (Vec<Motion>, Vec<TimeStepReport>, S::Saved) = (
+                motions.iter().map(|m| m.motion.clone()).collect(),
+                reports,
+                solver.save(),
+            );
             let mut kept_side = 0i32;
             let mut event = None;
             for _ in 0..MAX_REFINEMENTS {
@@ -261,13 +358,18 @@ impl BreakingBodies {
                 for (m, s) in motions.iter_mut().zip(&start) {
                     m.motion = s.clone();
                 }
-                let reports = solve(motions, &self.bodies, t, theta * rest)?;
+                solver.restore(start_solver.clone());
+                let reports = solver.solve(motions, &self.bodies, t, theta * rest)?;
                 let s = self.stresses(motions);
                 let worst = self.worst(&s);
                 if worst > 1.0 + AT_STRENGTH {
                     hi = theta;
                     shi = s;
-                    at_hi = (motions.iter().map(|m| m.motion.clone()).collect(), reports);
+                    at_hi = (
+                        motions.iter().map(|m| m.motion.clone()).collect(),
+                        reports,
+                        solver.save(),
+                    );
                     kept_side = if kept_side < 0 { kept_side - 1 } else { -1 };
                 } else if worst >= 1.0 - AT_STRENGTH {
                     event = Some((theta, s, reports));
@@ -285,12 +387,13 @@ impl BreakingBodies {
                     for (m, s) in motions.iter_mut().zip(at_hi.0) {
                         m.motion = s;
                     }
+                    solver.restore(at_hi.2);
                     (hi, shi, at_hi.1)
                 }
             };
             add(&mut total, reports);
             t = if theta >= 1.0 { end } else { t + theta * rest };
-            self.break_at_strength(motions, &s, t, duration, &mut total, rebalance);
+            self.break_at_strength::<S>(motions, &s, (t, duration), &mut total, rebalance);
             if t >= end {
                 return Ok(total);
             }
@@ -299,12 +402,11 @@ impl BreakingBodies {
 
     /// Break every intact breaking member at (or beyond) its strength in `stress`, at time
     /// `t`: its modulus factor to 0, its strain energy into the body's `dissipated`.
-    fn break_at_strength(
+    fn break_at_strength<S: TrialSteps>(
         &mut self,
         motions: &mut [BodyMotion],
         stress: &[Vec<Real>],
-        t: Real,
-        duration: Real,
+        (t, duration): (Real, Real),
         total: &mut [TimeStepReport],
         rebalance: bool,
     ) {
@@ -324,6 +426,11 @@ impl BreakingBodies {
             }
             let m = &mut motions[k];
             let before = strain_energy(body, &m.motion.u);
+            let mut lost = Vec::new();
+            if rebalance && S::OTHER_FORCES {
+                lost = vec![0.0; m.motion.u.len()];
+                internal_forces(body, &m.motion.u, &mut lost);
+            }
             if body.member_factors.is_empty() {
                 body.member_factors = vec![1.0; body.members.len()];
             }
@@ -334,7 +441,15 @@ impl BreakingBodies {
             }
             total[k].dissipated += before - strain_energy(body, &m.motion.u);
             m.forget_factor();
-            if rebalance {
+            if rebalance && S::OTHER_FORCES {
+                // The contact forces at the event are those of the intact body: keep them in
+                // the acceleration, taking away only the member forces that are gone.
+                let mut after = vec![0.0; lost.len()];
+                internal_forces(body, &m.motion.u, &mut after);
+                for &dof in &m.dofs.free {
+                    m.motion.a[dof] += (lost[dof] - after[dof]) / m.mass[dof];
+                }
+            } else if rebalance {
                 m.balance_acceleration(body, t, duration);
             }
         }

@@ -7,7 +7,7 @@ use crate::linkage::dynamics::{
 };
 use crate::linkage::fracture::breaks_members;
 use crate::linkage::{Body, PhaseTimes, SolveError};
-use crate::scene::dynamic_contact::DynamicContact;
+use crate::scene::dynamic_contact::{ContactTrialSteps, DynamicContact};
 use crate::scene::dynamic_fracture::BreakingBodies;
 use crate::scene::dynamics_settings::DynamicsSettings;
 use crate::scene::results::{
@@ -118,16 +118,6 @@ impl<'w> DynamicSimulation<'w> {
             motions.push(m);
         }
         let contact = if world.has_contact() {
-            if let Some(body) = world.bodies.iter().find(|b| breaks_members(b)) {
-                return Err(RunError::Solve {
-                    scene: world.source.clone(),
-                    source: SolveError::BreakingUnsupported {
-                        body: body.name.clone(),
-                        reason: "are not followed in time in a scene with contact yet (the event search of a time step does not roll back the contact state)".to_string(),
-                        remedy: "remove the obstacles and [contact], or remove [dynamics] for a quasi-static run".to_string(),
-                    },
-                });
-            }
             Some(DynamicContact::new(world, settings.duration)?)
         } else {
             None
@@ -178,13 +168,25 @@ impl<'w> DynamicSimulation<'w> {
                 let h = full * (ticks as Real / TICKS as Real);
                 let t0 = start + full * (pos as Real / TICKS as Real);
                 let integrator = self.integrator.as_ref();
+                let may_cut = self.depth < MAX_TIME_STEP_HALVINGS;
                 let solved = match (self.contact.as_mut(), self.fracture.as_mut()) {
-                    (Some(c), _) => c
+                    (Some(c), Some(f)) => f.solve_trial_step(
+                        &mut self.motions,
+                        &mut ContactTrialSteps {
+                            contact: c,
+                            integrator,
+                            may_cut,
+                            summary: &mut summary,
+                        },
+                        (t0, h, duration),
+                        integrator.needs_initial_acceleration(),
+                    ),
+                    (Some(c), None) => c
                         .solve(
                             &mut self.motions,
                             &world.bodies,
                             integrator,
-                            (t0, h, self.depth < MAX_TIME_STEP_HALVINGS),
+                            (t0, h, may_cut),
                         )
                         .map(|s| s.record(&mut summary)),
                     (None, Some(f)) => f.solve_step(

@@ -7,7 +7,9 @@ pub use self::check::{
 };
 pub use self::contact_concentration::{CONCENTRATED_SHARE, NEIGHBOUR_SLOPE};
 pub use self::driver::{run, run_in_memory, run_into, run_with};
-pub use self::dynamic_fracture::{BreakingBodies, StepSolve, TimedBreak, AT_STRENGTH, EVENT_TIME};
+pub use self::dynamic_fracture::{
+    BreakingBodies, StepSolve, TimedBreak, TrialSteps, AT_STRENGTH, EVENT_TIME,
+};
 pub use self::dynamic_simulation::{solve_time_step, DynamicSimulation, MAX_TIME_STEP_HALVINGS};
 pub use self::inline_files::InlineFiles;
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
