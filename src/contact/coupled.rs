@@ -89,6 +89,12 @@ impl CoupledSolver {
         Ok(())
     }
 
+    /// Drop the factored tangent kept for reuse: a body's members changed (a member broke),
+    /// so the next iteration factors the tangent anew.
+    pub(crate) fn forget_factor(&mut self) {
+        self.factored = None;
+    }
+
     /// [`CoupledSolver::rebuild`] after body `b`'s DOFs changed (a piece of it removed, or
     /// given back; `body` as it is now): the entries between bodies, in the old numbering, are
     /// dropped and found again as contacts need them; with conjugate gradients, the body's

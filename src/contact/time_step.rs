@@ -204,6 +204,12 @@ impl ContactSolver {
         }
     }
 
+    /// Forget the factored tangent the next time step would reuse (a body's member factors
+    /// changed: members broke, or a trial that broke them was undone).
+    pub fn forget_kept_factor(&mut self) {
+        self.coupled.forget_factor();
+    }
+
     /// Go back to a state saved by [`ContactSolver::time_step_state`] of this solver. The
     /// crossings into sharp obstacle features found since are forgotten (the next time step
     /// records them anew from the restored positions).

@@ -162,10 +162,16 @@ impl DynamicContact {
         let duration = self.duration;
         // Members broken so far (modulus factor 0) reach the bodies the contact solver
         // assembles; nothing else of a body changes in time.
+        // A kept factor of the tangent is then stale: it is dropped.
+        let mut changed = false;
         for (mine, given) in self.bodies.iter_mut().zip(world_bodies) {
             if mine.member_factors != given.member_factors {
                 mine.member_factors.clone_from(&given.member_factors);
+                changed = true;
             }
+        }
+        if changed {
+            self.solver.forget_kept_factor();
         }
         let forms: Vec<_> = motions
             .iter()

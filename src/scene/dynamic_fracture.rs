@@ -42,9 +42,9 @@
 //! is the contact step itself, bit for bit.
 //!
 //! The contact solver assembles its own copies of the bodies: the modulus factors of the broken
-//! members are copied to them before every sub-step, and its tangent is refactored at the first
-//! Newton iteration of every solve (a factor is reused only within one solve), so nothing
-//! stale survives a break. A break changes no position: the contacts at the event are those
+//! members are copied to them before every sub-step, and when they change the factor of the
+//! tangent kept from the last time step is dropped (`ContactSolver::forget_kept_factor`), so
+//! nothing stale survives a break. A break changes no position: the contacts at the event are those
 //! of the intact body, and a piece cut loose keeps its mass and its contacts (it may rest on,
 //! slide along or fly off what it touches). With contact, Newmark's and generalized-α's
 //! acceleration is not rebalanced on loads and members alone (that would drop the contact
