@@ -41,8 +41,8 @@ const STEPS: usize = 3;
 /// Models larger than these after mutation are not run (too slow for a fuzz case).
 const MAX_MEMBERS: usize = 50_000;
 const MAX_STEPS: usize = 10;
-/// A dynamic scene of more time steps than this is not run (the bundled one has 300).
-const MAX_TIME_STEPS: usize = 1000;
+/// A dynamic scene of more time steps than this is not run (the bundled ones have 300 to 2,000).
+const MAX_TIME_STEPS: usize = 2500;
 
 /// Values a number is replaced with.
 const EXTREMES: &[&str] = &[

@@ -475,8 +475,11 @@ fn sigterm_and_sigint_while_writing_vtk_exit_130_and_keep_the_old_vtk() {
         assert_ne!(s.code, Some(-1), "{what}: ended before the signal");
         assert_eq!(s.code, Some(130), "{what}: {}", s.stderr);
         assert!(s.seconds < 5.0, "{what}: {:.2} s to stop", s.seconds);
+        // The signal lands in the writing or, earlier, in the reading of the stored results
+        // (interruptible too since issue 33's item 2 was finished): both stop before a file.
         assert!(
-            s.stderr.contains("interrupted while writing the VTK files"),
+            s.stderr.contains("interrupted while writing the VTK files")
+                || s.stderr.contains("interrupted while reading the stored results"),
             "{what}: {}",
             s.stderr
         );
