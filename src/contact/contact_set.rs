@@ -143,4 +143,9 @@ pub struct NodeContact {
     pub state: SlipState,
     /// Slip of the node over what it touches, accumulated since the contact began, m.
     pub slip: Vector3<Real>,
+    /// Energy friction dissipated in the increment solved by the contacts this node presses
+    /// with, J: `−f_T · Δs` of each contact's return mapping (`Δs` the slip it added), counted
+    /// once per contact (on its pressing node; a sharp point's share by weight), never on
+    /// the nodes that only receive a contact's reaction.
+    pub friction_dissipated: Real,
 }

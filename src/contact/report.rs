@@ -61,16 +61,16 @@ pub(crate) fn finish(
         let name = p.geometry.target_name(bodies, e.contact.with).to_string();
         let n = e.normal.unwrap_or_default();
         let normal_force = n * e.normal_force();
-        let (tangential, state, slip) = match &e.tangential {
+        let (tangential, state, slip, dissipated) = match &e.tangential {
             Some(t) => {
                 let (key, _) = friction_key(&e.contact);
                 let before = p
                     .friction
                     .and_then(|h| h.committed.get(&key))
                     .map_or(Vector3::zeros(), |c| c.slip);
-                (t.force, t.state, before + t.slip)
+                (t.force, t.state, before + t.slip, -t.force.dot(&t.slip))
             }
-            None => (Vector3::zeros(), SlipState::Slip, Vector3::zeros()),
+            None => (Vector3::zeros(), SlipState::Slip, Vector3::zeros(), 0.0),
         };
         match state {
             SlipState::Stick => out.sticking += 1,
@@ -103,9 +103,19 @@ pub(crate) fn finish(
             } else {
                 (bodies[e.contact.body].name.clone(), 0.0)
             };
+            // The contact's dissipation once: on its pressing node, or a sharp point's
+            // surface nodes by their weights.
+            let share = if sharp {
+                w
+            } else if k == 0 {
+                1.0
+            } else {
+                0.0
+            };
             let list = &mut touched[b];
             match list.iter_mut().find(|t| t.node == node && t.with == with) {
                 Some(t) => {
+                    t.friction_dissipated += dissipated * share;
                     t.depth = t.depth.max(depth);
                     t.force += e.force() * w;
                     // Summed as vectors here; made a unit normal and its size below.
@@ -126,6 +136,7 @@ pub(crate) fn finish(
                     tangential_force: tangential * w,
                     state,
                     slip: slip * w,
+                    friction_dissipated: dissipated * share,
                 }),
             }
         }

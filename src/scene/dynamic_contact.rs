@@ -286,11 +286,11 @@ impl DynamicContact {
                     report.external_work += c.force.dot(o);
                 }
                 if c.depth > 0.0 {
-                    // Friction: −f_T · Δslip = μ f_N |Δslip| while slipping.
-                    let key = (k, c.node, c.with.clone());
-                    let before = self.slips.get(&key).copied().unwrap_or_else(Vector3::zeros);
-                    report.dissipated += (-c.tangential_force.dot(&(c.slip - before))).max(0.0);
-                    slips.insert(key, c.slip);
+                    // Friction: −f_T · Δs = μ f_N |Δs| while slipping, per contact. (Not the
+                    // difference of the node's summed slips: a node that presses and also
+                    // receives another contact's reaction sums both into one entry.)
+                    report.dissipated += c.friction_dissipated;
+                    slips.insert((k, c.node, c.with.clone()), c.slip);
                     // The penalty energy at the step's end: the depth at y carried to u_{n+1}
                     // along the normal (exact for a plane; the other body's move is not
                     // followed), ½ k d² with k = f_N / d.
