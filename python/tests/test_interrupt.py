@@ -21,6 +21,17 @@ def long_scene(steps: int, cells: int) -> linkage.Scene:
     return linkage.Scene("long", bodies=[body], steps=steps)
 
 
+@pytest.fixture(autouse=True)
+def python_handles_sigint():
+    """Python's own SIGINT handler for the test. A process started with SIGINT ignored (a
+    background job of a non-interactive shell, as CI may start it) gets no handler from
+    Python, and then neither SIGINT nor `_thread.interrupt_main` raises KeyboardInterrupt:
+    both tests failed that way, in a clean clone run in the background and once before."""
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, before)
+
+
 def interrupted_after(scene: linkage.Scene, seconds: float, send) -> float:
     """Send the interrupt `seconds` after `scene.run()`'s solve thread started, while it still
     runs (never after it ended: a stray signal would stop a later test); the delay until
