@@ -83,8 +83,6 @@ pub struct DynamicContact {
     deepest: Real,
     /// The largest penetration of the last time step solved, m.
     last_depth: Real,
-    /// Per (body, node, what it touches) the slip committed at the last time step, m.
-    slips: HashMap<(usize, usize, String), Vector3<Real>>,
     /// Per body, the contacts of the last time step solved (at its configuration `y`).
     pub contacts: Vec<Vec<NodeContact>>,
     /// Per body, the total contact force per obstacle or body touched, at the last step.
@@ -136,7 +134,6 @@ impl DynamicContact {
             duration,
             deepest,
             last_depth: 0.0,
-            slips: HashMap::new(),
             sticking: 0,
             slipping: 0,
             penalty_energy: 0.0,
@@ -244,7 +241,6 @@ impl DynamicContact {
             .map(|(o, d)| (o.name.as_str(), *d))
             .collect();
         let mut penalty = 0.0;
-        let mut slips = HashMap::new();
         for (k, ((m, body), form)) in motions.iter_mut().zip(world_bodies).zip(&forms).enumerate() {
             let d = body.dimension.dofs_per_node();
             let state = &solved.states[k];
@@ -290,7 +286,6 @@ impl DynamicContact {
                     // difference of the node's summed slips: a node that presses and also
                     // receives another contact's reaction sums both into one entry.)
                     report.dissipated += c.friction_dissipated;
-                    slips.insert((k, c.node, c.with.clone()), c.slip);
                     // The penalty energy at the step's end: the depth at y carried to u_{n+1}
                     // along the normal (exact for a plane; the other body's move is not
                     // followed), ½ k d² with k = f_N / d.
@@ -304,7 +299,6 @@ impl DynamicContact {
             m.motion = integrator.finish(&m.motion, du, h);
             out.reports.push(report);
         }
-        self.slips = slips;
         self.last_depth = out.max_penetration;
         self.penalty_energy = penalty;
         self.contacts = solved.contacts;
@@ -316,13 +310,11 @@ impl DynamicContact {
 }
 
 /// What a time step changes in a [`DynamicContact`]: the contact solver's state
-/// ([`TimeStepState`]) and the bookkeeping carried to the next step (committed slips, the last
-/// depth, the contacts and forces reported, the penalty energy).
+/// ([`TimeStepState`]) and the bookkeeping carried to the next step (the last depth, the contacts and forces reported, the penalty energy).
 #[derive(Clone)]
 pub struct DynamicContactState {
     solver: TimeStepState,
     last_depth: Real,
-    slips: HashMap<(usize, usize, String), Vector3<Real>>,
     contacts: Vec<Vec<NodeContact>>,
     totals: Vec<Vec<(String, Vector3<Real>)>>,
     sticking: usize,
@@ -336,7 +328,6 @@ impl DynamicContact {
         DynamicContactState {
             solver: self.solver.time_step_state(),
             last_depth: self.last_depth,
-            slips: self.slips.clone(),
             contacts: self.contacts.clone(),
             totals: self.totals.clone(),
             sticking: self.sticking,
@@ -350,7 +341,6 @@ impl DynamicContact {
     pub fn restore(&mut self, saved: DynamicContactState) {
         self.solver.restore_time_step_state(saved.solver);
         self.last_depth = saved.last_depth;
-        self.slips = saved.slips;
         self.contacts = saved.contacts;
         self.totals = saved.totals;
         self.sticking = saved.sticking;

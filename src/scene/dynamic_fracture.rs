@@ -35,7 +35,7 @@
 //! time step changes in the contact solver: the displacements the next step starts from, the
 //! contact set and its normals, friction's committed history (stick anchors and slips, so a
 //! retried sub-step slips from the same anchors and dissipates `μ f_N |Δslip|` once), the step
-//! count and pseudo-time, the committed slips and penalty energy of the energy bookkeeping.
+//! count and pseudo-time, the penalty energy of the energy bookkeeping.
 //! Each trial sub-step of the search starts from that state; the state at the bracket's end is
 //! saved with the motions there. So the sub-steps that make up a step are exactly the time
 //! steps of lengths `θ h, (1 − θ) h` of the contact solver, and a step in which nothing breaks
