@@ -1,9 +1,10 @@
 //! The coupled Newton of all bodies in contact: one sparse system of members and penalties, refactored per iteration (or kept while a linear model converges fast).
 
+use crate::contact::body_part::{largest_nodal_move, BodyPart};
 use crate::contact::coupled_iterative::CoupledIterative;
 use crate::contact::coupled_system::CoupledSystem;
 use crate::contact::evaluate::{Evaluated, Evaluation};
-use crate::contact::settle::{largest_nodal_move, BodyPart, Problem, STABILISATION};
+use crate::contact::problem::{Problem, STABILISATION};
 use crate::contact::{ActiveContact, ContactError, ContactSet};
 use crate::linalg::{CholeskyError, LowRankCorrection, SparseColumn};
 use crate::linkage::body_state::{fill_tangent, internal_force_vector, norm};

@@ -1,11 +1,11 @@
 //! Finding contacts: contact candidates, open-shell sides, and the query of every node against the obstacles and the other bodies.
 
+use crate::contact::body_part::{position, BodyPart};
 use crate::contact::boundary::{inside_polygon, segment_projection, Surface};
 use crate::contact::obstacle_features::Features;
 use crate::contact::obstacles::to_glam;
 use crate::contact::patch_surface::PatchSurface;
 use crate::contact::self_contact::SelfContact;
-use crate::contact::settle::{position, BodyPart};
 use crate::contact::{
     penetration_tolerance, ActiveContact, ContactError, ContactSet, Obstacle, Obstacles,
     SurfaceProblem, Target,

@@ -1,10 +1,10 @@
 //! Evaluating contacts: one small function per kind of target (obstacle, patch, segment, vertex) giving depth, normal, the nodes the force acts on and the penalty.
 
+use crate::contact::body_part::{position, BodyPart};
 use crate::contact::boundary::segment_projection;
 use crate::contact::detect::Geometry;
 use crate::contact::patch_surface::triangle_projection;
 use crate::contact::self_contact::closing;
-use crate::contact::settle::{position, BodyPart};
 use crate::contact::{
     return_mapping, ActiveContact, ContactSet, FrictionHistory, FrictionKey, Penalty, Tangential,
     Target,

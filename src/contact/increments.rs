@@ -9,8 +9,8 @@
 //! step is reported.
 
 use crate::contact::evaluate::friction_key;
+use crate::contact::problem::{newton_limits, Problem, PATH_POINTS};
 use crate::contact::report::ContactStep;
-use crate::contact::settle::{newton_limits, Problem, PATH_POINTS};
 use crate::contact::{ActiveContact, Committed, ContactError, ContactSet, ContactSolver, Obstacle};
 use crate::linalg::CholeskyError;
 use crate::linkage::body_state::{loads_at, norm, prescribed_at};

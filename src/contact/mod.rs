@@ -23,6 +23,7 @@ pub use self::start::StartOverlap;
 pub use self::surface::{cut_by_z0, obstacle_surface, Surface};
 pub use self::time_step::TimeStepState;
 
+mod body_part;
 mod boundary;
 mod condensed;
 mod contact_set;
@@ -42,6 +43,7 @@ mod obstacle_features;
 mod obstacles;
 mod patch_surface;
 mod penalty;
+mod problem;
 mod report;
 mod self_contact;
 mod self_watch;

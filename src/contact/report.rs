@@ -1,8 +1,9 @@
 //! The report of a settled step: each body's state, the contacts each node receives, the totals per pair, and the warnings.
 
+use crate::contact::body_part::BodyPart;
 use crate::contact::evaluate::friction_key;
 use crate::contact::evaluate::Evaluation;
-use crate::contact::settle::{BodyPart, Problem};
+use crate::contact::problem::Problem;
 use crate::contact::{ContactError, NodeContact, SlipState, Target};
 use crate::linkage::body_state::{internal_force_vector, member_response_at, norm};
 use crate::linkage::{post_process, Body, StepState};

@@ -34,9 +34,9 @@
 //! spacing are held only where they meet the body's outer surface; 2D holes and the crack
 //! faces are not surfaces for condition 1–3 (only the outer boundary loop is).
 
+use crate::contact::body_part::{position, BodyPart};
 use crate::contact::boundary::{segment_projection, Surface};
 use crate::contact::patch_surface::PatchSurface;
-use crate::contact::settle::{position, BodyPart};
 use crate::contact::ties::{self, Candidate, Pressed};
 use crate::contact::{penetration_tolerance, ActiveContact, ContactSet, Penalty, Target};
 use crate::linkage::body_state::{linear_stretch, undeformed_axis};

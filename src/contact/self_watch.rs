@@ -10,8 +10,8 @@
 //! finds exactly what the contact solver would find at the same state. Pieces that fell off
 //! (removed from the body's solve, held at rest) neither press nor are pressed.
 
+use crate::contact::body_part::BodyPart;
 use crate::contact::detect::Geometry;
-use crate::contact::settle::BodyPart;
 use crate::contact::{
     default_penalty, penetration_tolerance, ContactError, ContactSet, Penalty, Target,
 };

@@ -1,167 +1,26 @@
 //! The settle loop of one load step (solve → find contacts → penalties, until the contact set and equilibrium settle) and the coupled Newton of all bodies.
 
+use crate::contact::body_part::BodyPart;
 use crate::contact::condensed::CondensedSolver;
 use crate::contact::coupled::CoupledSolver;
 use crate::contact::coupled_iterative::CoupledIterative;
 use crate::contact::detect::{candidate_nodes, Geometry};
-use crate::contact::evaluate::{evaluate, Evaluation};
+use crate::contact::problem::{interrupted, newton_limits, Problem, FORCE_FLOOR};
 use crate::contact::report::{finish, ContactStep};
 use crate::contact::start::{no_start_overlap, one_dimension};
 use crate::contact::{
     default_penalty, penetration_tolerance, ActiveContact, ContactError, ContactSet,
     ContactSettings, FrictionHistory, Obstacle, Penalty, Target,
 };
-use crate::linkage::body_state::{loads_at, node_vector, prescribed_at};
+use crate::linkage::body_state::{loads_at, prescribed_at};
 use crate::linkage::dynamics::InertiaTerm;
 use crate::linkage::{
-    Body, Convergence, DofMap, Mechanism, PathMethod, PhaseTimes, SolveError, SolverUsed,
-    StiffnessAssembly,
+    Body, DofMap, Mechanism, PathMethod, PhaseTimes, SolveError, SolverUsed, StiffnessAssembly,
 };
 use crate::Real;
 use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::time::Instant;
-
-/// The stabilisation of a singular tangent, relative to its largest diagonal entry: small
-/// enough that the stabilised matrix is still the tangent to 9 digits, large enough to factor.
-pub const STABILISATION: Real = 1e-9;
-
-/// See [`ContactSolver::force_floor`].
-pub const FORCE_FLOOR: Real = 1e-10;
-
-/// Converged states kept for the extrapolated start of an increment (three: up to a
-/// quadratic through them, as a body's Newton).
-pub(crate) const PATH_POINTS: usize = 3;
-
-/// One body's part of the solve.
-pub(crate) struct BodyPart {
-    /// The body's free and supported DOFs.
-    pub(crate) dofs: DofMap,
-    /// The body's stiffness pattern, computed once.
-    pub(crate) assembly: StiffnessAssembly,
-    /// Displacement per body DOF, m (kept between steps: the next step starts here).
-    pub(crate) u: Vec<Real>,
-    /// The body's penalty.
-    pub(crate) penalty: Penalty,
-    /// Penetration above which a step is warned about, m.
-    pub(crate) tolerance: Real,
-    /// The body's tangent values in its assembly's pattern, N/m.
-    pub(crate) local: Vec<Real>,
-}
-
-/// The deformed position of `node` of body `b`, m.
-pub(crate) fn position(
-    bodies: &[Body],
-    parts: &[BodyPart],
-    b: usize,
-    node: usize,
-) -> Vector3<Real> {
-    let part = &parts[b];
-    bodies[b].nodes[node] + node_vector(&part.u, part.dofs.dofs_per_node, node)
-}
-
-/// What a contact Newton iterates on: the bodies and their surfaces, the contact set held
-/// fixed, and the step's loads and limits.
-pub(crate) struct Problem<'a> {
-    /// The bodies, in scene order.
-    pub(crate) bodies: &'a [Body],
-    /// Their surfaces and the obstacles.
-    pub(crate) geometry: &'a Geometry,
-    /// The contacts held fixed.
-    pub(crate) set: &'a ContactSet,
-    /// Applied force per body DOF of each body, N.
-    pub(crate) forces: &'a [Vec<Real>],
-    /// Obstacle offsets along their travel, m.
-    pub(crate) offsets: &'a [Vector3<Real>],
-    /// The step (for messages).
-    pub(crate) step: usize,
-    /// Converged when the relative residual is at most this.
-    pub(crate) tolerance: Real,
-    /// Newton iterations allowed.
-    pub(crate) max_iterations: usize,
-    /// Largest nodal move of a stabilised iteration, m.
-    pub(crate) move_cap: Real,
-    /// The smallest force scale of a residual, N.
-    pub(crate) force_floor: Real,
-    /// Friction and its history (`None`: every pair frictionless).
-    pub(crate) friction: Option<&'a FrictionHistory>,
-    /// Per body, the inertia term of a time step (`None`: a load step, no inertia).
-    pub(crate) inertia: Option<&'a [InertiaTerm]>,
-}
-
-impl Problem<'_> {
-    /// Every contact of the set evaluated at the bodies' current displacements.
-    pub(crate) fn evaluate(
-        &self,
-        normals: &mut HashMap<ActiveContact, Vector3<Real>>,
-        parts: &[BodyPart],
-    ) -> Evaluation {
-        evaluate(
-            self.geometry,
-            normals,
-            self.bodies,
-            parts,
-            self.set,
-            self.offsets,
-            self.friction,
-        )
-    }
-
-    /// Record the residual `rnorm` against `scale` (N) after `iterations` and decide: converged
-    /// (`true`) when the relative residual is within the tolerance, stalled, or the last step
-    /// (m) was at most 1e-12 of `size` (m: a correction that no longer moves anything, round-off
-    /// over a force scale of round-off, has converged too); `Err` when it is not finite or the
-    /// iterations are used up.
-    pub(crate) fn converged(
-        &self,
-        monitor: &mut Convergence,
-        rnorm: Real,
-        scale: Real,
-        iterations: usize,
-        last_step: Real,
-        size: Real,
-    ) -> Result<bool, ContactError> {
-        if interrupted(self.bodies) {
-            return Err(ContactError::Interrupted { step: self.step });
-        }
-        monitor
-            .record(Convergence::relative(rnorm, scale))
-            .map_err(|_| ContactError::NotFinite { step: self.step })?;
-        if monitor.within_tolerance()
-            || monitor.stalled()
-            || (iterations > 0 && last_step <= 1e-12 * size)
-        {
-            return Ok(true);
-        }
-        if iterations >= self.max_iterations {
-            return Err(ContactError::NotConverged {
-                step: self.step,
-                depth: 0,
-                cuts: 0,
-                reason: format!("no convergence in {iterations} Newton iterations"),
-                history: monitor.history.clone(),
-            });
-        }
-        Ok(false)
-    }
-
-    /// The fraction of a stabilised correction to take when its largest nodal move (m) is
-    /// beyond the move cap (`None`: a Newton step).
-    pub(crate) fn capped(&self, largest: Real) -> Option<Real> {
-        (largest > self.move_cap).then(|| self.move_cap / largest)
-    }
-}
-
-/// The largest nodal length of a move of `part`, m, given per free index by `moved` (m).
-pub(crate) fn largest_nodal_move(part: &BodyPart, mut moved: impl FnMut(usize) -> Real) -> Real {
-    let d = part.dofs.dofs_per_node;
-    let mut moves = vec![0.0; part.u.len() / d.max(1)];
-    for (i, &dof) in part.dofs.free.iter().enumerate() {
-        let m = moved(i);
-        moves[dof / d] += m * m;
-    }
-    moves.into_iter().map(Real::sqrt).fold(0.0, Real::max)
-}
 
 /// All the bodies of a scene with contact, solved together step by step.
 ///
@@ -640,26 +499,4 @@ impl ContactSolver {
             &mut self.times,
         )
     }
-}
-
-/// Whether the run was asked to stop (the bodies' [`crate::linkage::NewtonSettings`] carry the
-/// run's interrupt).
-pub(crate) fn interrupted(bodies: &[Body]) -> bool {
-    bodies.iter().any(|b| b.newton.interrupt.is_raised())
-}
-
-/// The Newton tolerance of a contact scene (the smallest of the bodies', at most 1e-10) and the
-/// iterations allowed per contact set (the largest of the bodies').
-pub(crate) fn newton_limits(bodies: &[Body]) -> (Real, usize) {
-    let tolerance = bodies
-        .iter()
-        .map(|b| b.newton.tolerance)
-        .fold(Real::INFINITY, Real::min)
-        .min(1e-10);
-    let max_iterations = bodies
-        .iter()
-        .map(|b| b.newton.max_iterations)
-        .max()
-        .unwrap_or(30);
-    (tolerance, max_iterations)
 }

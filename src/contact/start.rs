@@ -1,9 +1,9 @@
 //! The state a contact scene starts from: all bodies of one dimension, and no node inside an
 //! obstacle or another body by more than the contact tolerance at step 0.
 
+use crate::contact::body_part::BodyPart;
 use crate::contact::detect::Geometry;
 use crate::contact::evaluate::evaluate;
-use crate::contact::settle::BodyPart;
 use crate::contact::{ContactError, Target};
 use crate::linkage::Body;
 use crate::Real;

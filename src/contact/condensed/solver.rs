@@ -1,5 +1,6 @@
 //! The condensed Newton of the settle loop when every body is linear: on the contact candidates only, each body factored once per run.
 
+use crate::contact::body_part::{largest_nodal_move, BodyPart};
 use crate::contact::condensed::anderson::Anderson;
 use crate::contact::condensed::{
     approximate_from, exact_for, CondenseFailure, CondensedBody, ContactJacobian, ContactRow,
@@ -7,7 +8,7 @@ use crate::contact::condensed::{
 };
 use crate::contact::detect::widen;
 use crate::contact::evaluate::friction_key;
-use crate::contact::settle::{largest_nodal_move, BodyPart, Problem, STABILISATION};
+use crate::contact::problem::{Problem, STABILISATION};
 use crate::contact::{
     ActiveContact, ContactError, ContactSet, FrictionHistory, FrictionKey, SlipState,
 };
