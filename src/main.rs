@@ -840,8 +840,8 @@ fn export(scene: &Path, out: &Path) -> Result<()> {
 
 fn render(a: &RenderArgs) -> Result<()> {
     use linkage::render::gltf::write_gltf;
-    use linkage::render::{render_run_to, stored_time, RenderOptions};
-    use linkage::scene::{write_vtk, RunResults, VtkEncoding};
+    use linkage::render::{draw_read_run_to, read_run_to_render, stored_time, RenderOptions};
+    use linkage::scene::{write_vtk, VtkEncoding};
     catch_signals();
     // A published results folder always has its summary: without it the folder is not one.
     let summary = a.dir.join("summary.json");
@@ -866,7 +866,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         gif: !a.no_gif,
         supersampling: a.supersampling,
         interrupt: Interrupt::on(&STOP),
-        // Read from the results folder's plot settings by `render_run_to`.
+        // Read from the results folder's plot settings by `draw_read_run_to`.
         step_fraction: false,
     };
     let out = a.out.clone().unwrap_or_else(|| a.dir.clone());
@@ -874,7 +874,10 @@ fn render(a: &RenderArgs) -> Result<()> {
         create_out_folder(&out)?;
     }
     let t = Instant::now();
-    let report = render_run_to(&a.dir, &out, &options)?;
+    // The stored steps are read once: the frames, the GLB, the VTK files, the plots and the
+    // report's 3D view are all made from this reading.
+    let run = read_run_to_render(&a.dir, &options)?;
+    let report = draw_read_run_to(&run, &a.dir, &out, &options)?;
     let seconds = t.elapsed().as_secs_f64();
     if options.png || options.gif {
         say!(
@@ -895,7 +898,6 @@ fn render(a: &RenderArgs) -> Result<()> {
         );
     }
     if a.gltf {
-        let run = RunResults::read_until(&a.dir, Interrupt::on(&STOP))?;
         let g = write_gltf(&run, &out, report.magnification, stored_time)?;
         println!(
             "wrote {} ({} frame{} of {} stored step{}{}, displacements ×{})",
@@ -913,7 +915,6 @@ fn render(a: &RenderArgs) -> Result<()> {
         );
     }
     if a.vtk {
-        let run = RunResults::read_until(&a.dir, Interrupt::on(&STOP))?;
         let encoding = if a.vtk_ascii {
             VtkEncoding::Ascii
         } else {
@@ -928,7 +929,7 @@ fn render(a: &RenderArgs) -> Result<()> {
     }
     // The plots too, with the settings the run kept; the report when the folder is a job of
     // a batch folder and is drawn in place.
-    let plots = linkage::render::redraw_plots(&a.dir, &out)?;
+    let plots = linkage::render::redraw_plots_of(&a.dir, &out, &run)?;
     say!(
         "drew {} plot{} in {}",
         plots.len(),
@@ -936,7 +937,7 @@ fn render(a: &RenderArgs) -> Result<()> {
         out.join(linkage::render::plots::PLOTS).display()
     );
     if a.out.is_none() {
-        if let Some(page) = linkage::render::redraw_report(&a.dir)? {
+        if let Some(page) = linkage::render::redraw_report_of(&a.dir, Some(&run))? {
             say!("report {}", page.display());
         }
     }

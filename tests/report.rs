@@ -14,6 +14,10 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc::{channel, Receiver};
 use std::time::{Duration, Instant};
 
+#[path = "common/viewer_checks.rs"]
+mod viewer_checks;
+use viewer_checks::{check_viewer_scenes, click, run_viewer_scenes, Tab, VIEWER_STATE};
+
 fn required() -> bool {
     std::env::var("CI").is_ok_and(|v| v == "true")
 }
@@ -401,24 +405,28 @@ fn the_report_opens_in_chromium_with_every_image_and_every_job() {
     );
 }
 
-/// The viewer's state: whether it has WebGL, its frames, and the picture's drawn pixels and
-/// fingerprint.
-const VIEWER_STATE: &str = "JSON.stringify((() => { const v = window.linkageViewer; \
-    if (!v) return {ready: false}; if (!v.webgl) return {ready: true, webgl: false}; \
-    return {ready: true, webgl: true, frames: v.frames, frame: v.frame(), \
-    label: document.getElementById('viewer-label').textContent, ...v.pixels()}; })())";
-
-/// Move the viewer's slider to frame `k` as a user does (an `input` event).
-fn slide(k: usize) -> String {
-    format!(
-        "(() => {{ const s = document.getElementById('viewer-slider'); s.value = '{k}'; \
-         s.dispatchEvent(new Event('input')); return JSON.stringify(1); }})()"
-    )
+/// A tab of the Chromium this test drives, for the checks both browsers share.
+struct ChromiumTab<'a> {
+    browser: &'a mut Browser,
+    session: String,
 }
 
-/// Click the viewer's checkbox `name` (`contacts`, `broken`, `obstacles`).
-fn click(name: &str) -> String {
-    format!("(() => {{ document.getElementById('viewer-{name}').click(); return JSON.stringify(1); }})()")
+impl Tab for ChromiumTab<'_> {
+    fn open(&mut self, file: &Path) {
+        self.browser.open(&self.session, file);
+    }
+
+    fn evaluate(&mut self, expression: &str) -> Value {
+        self.browser.evaluate(&self.session, expression)
+    }
+
+    fn errors(&mut self) -> Vec<Value> {
+        self.browser.errors(&self.session)
+    }
+
+    fn clear(&mut self) {
+        self.browser.events.clear();
+    }
 }
 
 #[test]
@@ -430,13 +438,69 @@ fn the_viewer_draws_a_2d_and_a_3d_run_and_its_slider_and_toggles_change_the_pict
         return;
     };
     let out = tempfile::tempdir().unwrap();
-    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    // The notched beam: 2D, pressed by a cylinder (contact), breaking (fracture). The shell:
-    // 3D, pressed by a rising block.
+    run_viewer_scenes(out.path());
+    let mut browser = Browser::start(&program);
+    let session = browser.tab();
+    let mut tab = ChromiumTab {
+        browser: &mut browser,
+        session,
+    };
+    check_viewer_scenes(&mut tab, out.path(), "chromium");
+}
+
+/// A 0.1 m square column 0.5 m tall standing on z = 0 (`up = "z"`), above a wide slab (an
+/// obstacle below z = 0): in a y-up view it would lie on its side.
+const COLUMN_Z_UP: &str = r#"name = "column_z_up"
+steps = 1
+
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+
+[[bodies]]
+name = "column"
+box_lattice = { size = [0.1, 0.1, 0.5], cells = [1, 1, 4] }
+material = "steel"
+
+[[bodies.supports]]
+on_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 1.0] }
+fix = ["x", "y", "z"]
+
+[[bodies.loads]]
+on_plane = { point = [0.0, 0.0, 0.5], normal = [0.0, 0.0, 1.0] }
+total_force = [0.0, 0.0, -1000.0]
+
+[[obstacles]]
+name = "slab"
+shape = "cuboid"
+center = [0.05, 0.05, -0.06]
+half_extents = [0.3, 0.3, 0.05]
+
+[output]
+up = "z"
+"#;
+
+/// The drawn box `[left, top, right, bottom]` of a viewer state, canvas pixels from the top.
+fn drawn_box(state: &Value) -> [i64; 4] {
+    let b = state["box"].as_array().unwrap_or_else(|| panic!("{state}"));
+    [0, 1, 2, 3].map(|k| b[k].as_i64().unwrap())
+}
+
+#[test]
+fn the_viewer_stands_a_z_up_column_upright_on_its_slab() {
+    let Some(program) = chromium() else {
+        let why = "no chromium on PATH (Debian: apt-get install chromium)";
+        assert!(!required(), "CI=true: {why}");
+        eprintln!("skipped: {why}");
+        return;
+    };
+    let out = tempfile::tempdir().unwrap();
+    let scene = out.path().join("column_z_up.toml");
+    std::fs::write(&scene, COLUMN_Z_UP).unwrap();
     let o = linkage()
         .arg("run")
-        .arg(scenes.join("notched_beam.toml"))
-        .arg(scenes.join("shell_on_block_moving.toml"))
+        .arg(&scene)
         .arg("--out")
         .arg(out.path())
         .arg("--png")
@@ -444,56 +508,35 @@ fn the_viewer_draws_a_2d_and_a_3d_run_and_its_slider_and_toggles_change_the_pict
         .unwrap();
     assert!(o.status.success(), "{o:?}");
     let mut browser = Browser::start(&program);
-    let tab = browser.tab();
-    for (scene, toggles) in [
-        ("notched_beam", ["contacts", "broken"]),
-        ("shell_on_block_moving", ["contacts", "obstacles"]),
-    ] {
-        let dir = out.path().join(scene);
-        let stored = std::fs::read_dir(dir.join("steps")).unwrap().count();
-        browser.events.clear();
-        browser.open(&tab, &dir.join("index.html"));
-        let first = browser.evaluate(&tab, VIEWER_STATE);
-        assert_eq!(first["webgl"], json!(true), "{scene}: {first}");
-        assert_eq!(first["frames"], json!(stored), "{scene}: every stored step");
-        let total = first["total"].as_u64().unwrap();
-        let drawn = first["drawn"].as_u64().unwrap();
-        assert!(
-            drawn * 200 > total,
-            "{scene}: the canvas is drawn (over 0.5 % of it): {first}"
-        );
-        browser.evaluate(&tab, &slide(stored - 1));
-        let last = browser.evaluate(&tab, VIEWER_STATE);
-        assert_eq!(last["frame"], json!(stored - 1), "{last}");
-        assert_ne!(
-            last["hash"], first["hash"],
-            "{scene}: the last step looks different"
-        );
-        assert!(
-            last["label"]
-                .as_str()
-                .unwrap()
-                .contains(&format!("{stored} of {stored}")),
-            "{last}"
-        );
-        for t in toggles {
-            browser.evaluate(&tab, &click(t));
-            let off = browser.evaluate(&tab, VIEWER_STATE);
-            assert_ne!(
-                off["hash"], last["hash"],
-                "{scene}: switching {t} off changes the picture"
-            );
-            browser.evaluate(&tab, &click(t));
-            let on = browser.evaluate(&tab, VIEWER_STATE);
-            assert_eq!(
-                on["hash"], last["hash"],
-                "{scene}: switching {t} on again restores it"
-            );
-        }
-        let errors = browser.errors(&tab);
-        assert!(
-            errors.is_empty(),
-            "{scene}'s page logged errors: {errors:?}"
-        );
-    }
+    let session = browser.tab();
+    let mut tab = ChromiumTab {
+        browser: &mut browser,
+        session,
+    };
+    tab.open(&out.path().join("column_z_up/index.html"));
+    let with_slab = tab.evaluate(VIEWER_STATE);
+    assert_eq!(with_slab["webgl"], json!(true), "{with_slab}");
+    tab.evaluate(&click("obstacles"));
+    let column = tab.evaluate(VIEWER_STATE);
+    let [left, top, right, bottom] = drawn_box(&column);
+    // The column alone stands: over twice as tall as wide on the canvas (0.5 m against a
+    // 0.1 m square seen from 35° aside: about 3.5 times; lying, it would be wider than tall).
+    let (width, height) = (right - left + 1, bottom - top + 1);
+    assert!(
+        height > 2 * width,
+        "the column stands upright: {width} × {height} pixels, {column}"
+    );
+    // Its base is at the bottom: the slab under it adds pixels below the column and none
+    // above it (upside down, the slab would be drawn above the column).
+    let [_, slab_top, _, slab_bottom] = drawn_box(&with_slab);
+    assert!(
+        slab_bottom > bottom + 10,
+        "the slab is drawn below the column: bottom {slab_bottom} against {bottom}"
+    );
+    assert!(
+        (slab_top - top).abs() <= 1,
+        "nothing above the column's top: top {slab_top} against {top}"
+    );
+    let errors = tab.errors();
+    assert!(errors.is_empty(), "the page logged errors: {errors:?}");
 }

@@ -20,9 +20,12 @@ pub use self::options::{Colouring, Projection, RenderOptions, StepSelection};
 pub use self::picture::{camera_for, draw_frame, frame_primitives, view_for, viewport_for};
 pub use self::primitives::{paint, Layer, Mesh, MeshKind, Primitive};
 pub use self::raster::{Lighting, RasterVertex, Rasteriser, PLANE_ALPHA, VEIL_ALPHA};
-pub use self::replot::{read_summary, redraw_plots, redraw_report, ReplotError};
+pub use self::replot::{
+    read_summary, redraw_plots, redraw_plots_of, redraw_report, redraw_report_of, ReplotError,
+};
 pub use self::run_pictures::{
-    draw_run, render_run, render_run_to, select_steps, PictureWriter, RenderReport,
+    draw_read_run_to, draw_run, read_run_to_render, render_run, render_run_to, select_steps,
+    PictureWriter, RenderReport,
 };
 
 mod animated_run;

@@ -53,10 +53,19 @@ pub fn read_summary(dir: &Path) -> Result<Summary, ReplotError> {
 /// with the plot settings the run kept (the default ones for a folder written before they
 /// were kept).
 pub fn redraw_plots(dir: &Path, out: &Path) -> Result<Vec<WrittenPlot>, ReplotError> {
+    redraw_plots_of(dir, out, &RunResults::read(dir)?)
+}
+
+/// [`redraw_plots`] of `run`, the stored steps of `dir` read already (`linkage render`
+/// reads them once for the frames, the GLB, the VTK files, the plots and the report).
+pub fn redraw_plots_of(
+    dir: &Path,
+    out: &Path,
+    run: &RunResults,
+) -> Result<Vec<WrittenPlot>, ReplotError> {
     let summary = read_summary(dir)?;
-    let run = RunResults::read(dir)?;
     let settings = PlotSettings::read(dir);
-    Ok(plot_run(&summary, &run, &settings, out)?)
+    Ok(plot_run(&summary, run, &settings, out)?)
 }
 
 /// Write the report again when the results folder `dir` is a job of a batch folder: the
@@ -64,6 +73,15 @@ pub fn redraw_plots(dir: &Path, out: &Path) -> Result<Vec<WrittenPlot>, ReplotEr
 /// for it: the batch page and this job's page (the other jobs' pages are kept). Returns the
 /// batch page's path, or `None` when `dir` belongs to no batch folder.
 pub fn redraw_report(dir: &Path) -> Result<Option<PathBuf>, ReplotError> {
+    redraw_report_of(dir, None)
+}
+
+/// [`redraw_report`], the 3D view of `dir`'s page made from `run` when given (the stored
+/// steps of `dir` read already), else from the steps read again.
+pub fn redraw_report_of(
+    dir: &Path,
+    run: Option<&RunResults>,
+) -> Result<Option<PathBuf>, ReplotError> {
     let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
     for out in dir.ancestors().skip(1).take(2) {
         let table = out.join(TABLE);
@@ -81,10 +99,11 @@ pub fn redraw_report(dir: &Path) -> Result<Option<PathBuf>, ReplotError> {
         if !rows.iter().any(|r| r.job == job) {
             continue;
         }
-        let page = write_report_of(out, &rows, Some(&job)).map_err(|e| ReplotError::Report {
-            path: out.join(crate::render::report::REPORT),
-            message: e.to_string(),
-        })?;
+        let page =
+            write_report_of(out, &rows, Some((&job, run))).map_err(|e| ReplotError::Report {
+                path: out.join(crate::render::report::REPORT),
+                message: e.to_string(),
+            })?;
         return Ok(Some(page));
     }
     Ok(None)

@@ -92,22 +92,41 @@ pub fn render_run_to(
     out: &Path,
     options: &RenderOptions,
 ) -> Result<RenderReport, RenderError> {
+    let run = read_run_to_render(dir, options)?;
+    draw_read_run_to(&run, dir, out, options)
+}
+
+/// The stored run in `dir` read once for drawing (and for whatever else `linkage render`
+/// writes of it: the GLB, the VTK files, the plots and the report's 3D view), after
+/// `options` and its step selection are checked; stops between step files when
+/// `options.interrupt` is raised.
+pub fn read_run_to_render(dir: &Path, options: &RenderOptions) -> Result<RunResults, RenderError> {
     options.check()?;
+    let stored = StoredRun::open(dir)?;
+    // The selection is checked before the steps are read.
+    select_steps(&stored, &options.steps)?;
+    Ok(stored.read_all_until(options.interrupt)?)
+}
+
+/// Draw `run`, read from the results folder `dir` ([`read_run_to_render`]), into `out` as
+/// [`render_run_to`] does (with the plot settings `dir` kept).
+pub fn draw_read_run_to(
+    run: &RunResults,
+    dir: &Path,
+    out: &Path,
+    options: &RenderOptions,
+) -> Result<RenderReport, RenderError> {
     let options = &RenderOptions {
         step_fraction: options.step_fraction || PlotSettings::read(dir).step_fraction,
         ..options.clone()
     };
-    let stored = StoredRun::open(dir)?;
-    // The selection is checked before the steps are read.
-    select_steps(&stored, &options.steps)?;
-    let run = stored.read_all_until(options.interrupt)?;
     if out != dir {
         std::fs::create_dir_all(out).map_err(|source| RenderError::Write {
             path: out.to_path_buf(),
             source,
         })?;
     }
-    draw_run(&run, out, options)
+    draw_run(run, out, options)
 }
 
 /// Draw `run` into the folder `dir` as [`render_run`] does: `png/NNNN.png` per step

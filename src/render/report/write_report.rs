@@ -23,13 +23,18 @@ pub fn write_report(out: &Path, rows: &[Row]) -> std::io::Result<PathBuf> {
 }
 
 /// [`write_report`], with the page of job `only` alone written again when it is given (the
-/// others kept as they are: `linkage render` of one job's folder).
-pub fn write_report_of(out: &Path, rows: &[Row], only: Option<&str>) -> std::io::Result<PathBuf> {
+/// others kept as they are: `linkage render` of one job's folder), its 3D view made from the
+/// job's stored steps when they are given (read once by `linkage render`), else read again.
+pub fn write_report_of(
+    out: &Path,
+    rows: &[Row],
+    only: Option<(&str, Option<&RunResults>)>,
+) -> std::io::Result<PathBuf> {
     let jobs: Vec<(&Row, JobFiles)> = rows.iter().map(|r| (r, JobFiles::find(out, r))).collect();
     for (row, files) in &jobs {
-        if !files.folder.is_empty() && only.is_none_or(|j| j == row.job) {
+        if !files.folder.is_empty() && only.is_none_or(|(j, _)| j == row.job) {
             let dir = files.dir(out);
-            let viewer = viewer_of(&dir);
+            let viewer = viewer_of(&dir, only.and_then(|(_, run)| run));
             write_atomically(
                 &dir.join(REPORT),
                 scene_page(row, files, &viewer).as_bytes(),
@@ -58,15 +63,22 @@ pub fn write_report_of(out: &Path, rows: &[Row], only: Option<&str>) -> std::io:
     Ok(path)
 }
 
-/// The 3D view of the results in `dir` (its stored steps read back, decimated to
-/// [`VIEWER_BUDGET`], displacements magnified as the pictures do by default), or a note why
-/// there is none.
-fn viewer_of(dir: &Path) -> String {
-    match RunResults::read(dir) {
+/// The 3D view of the results in `dir` (`run`, its stored steps, when given, else read
+/// back; decimated to [`VIEWER_BUDGET`], displacements magnified as the pictures do by
+/// default), or a note why there is none.
+fn viewer_of(dir: &Path, run: Option<&RunResults>) -> String {
+    let read;
+    let run = match run {
+        Some(run) => Ok(run),
+        None => {
+            read = RunResults::read(dir);
+            read.as_ref()
+        }
+    };
+    match run {
         Ok(run) => {
-            let magnification = RunExtent::of_run(&run, None).magnification;
-            let mut animation =
-                AnimatedRun::of_run(&run, magnification, VIEWER_BUDGET, stored_time);
+            let magnification = RunExtent::of_run(run, None).magnification;
+            let mut animation = AnimatedRun::of_run(run, magnification, VIEWER_BUDGET, stored_time);
             animation.load_name = PlotSettings::read(dir).load_name();
             viewer_section(&viewer_data(&animation))
         }

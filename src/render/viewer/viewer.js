@@ -343,7 +343,9 @@
   drawScale();
   setFrame(0);
 
-  // For tests: the pixels of the picture that are not background, and a fingerprint.
+  // For tests: the pixels of the picture that are not background, the box around them
+  // ([left, top, right, bottom], canvas pixels from the top left; null when none), and a
+  // fingerprint.
   const pixels = () => {
     draw();
     const c = document.createElement('canvas');
@@ -354,11 +356,18 @@
     const img = ctx.getImageData(0, 0, c.width, c.height).data;
     let drawn = 0;
     let hash = 2166136261;
+    let box = null;
     for (let i = 0; i < img.length; i += 4) {
-      if (img[i] < 247 || img[i + 1] < 247 || img[i + 2] < 247) drawn++;
+      if (img[i] < 247 || img[i + 1] < 247 || img[i + 2] < 247) {
+        drawn++;
+        const x = (i / 4) % c.width;
+        const y = Math.floor(i / 4 / c.width);
+        if (!box) box = [x, y, x, y];
+        box = [Math.min(box[0], x), Math.min(box[1], y), Math.max(box[2], x), Math.max(box[3], y)];
+      }
       hash = Math.imul(hash ^ (img[i] + 3 * img[i + 1] + 7 * img[i + 2]), 16777619) >>> 0;
     }
-    return { drawn, hash, total: img.length / 4 };
+    return { drawn, hash, box, total: img.length / 4 };
   };
   window.linkageViewer = { ready: true, webgl: true, frames: n, setFrame, pixels, frame: () => current };
 })();
