@@ -24,6 +24,7 @@ pub use self::replot::{read_summary, redraw_plots, redraw_report, ReplotError};
 pub use self::run_pictures::{
     draw_run, render_run, render_run_to, select_steps, PictureWriter, RenderReport,
 };
+pub use self::shared_scale::{draw_with_shared_scale, SharedScale, VariantPictures, PICTURE_SCALE};
 
 mod animated_run;
 mod camera;
@@ -51,5 +52,6 @@ mod raster;
 mod replot;
 pub mod report;
 mod run_pictures;
+mod shared_scale;
 mod text;
 pub mod viewer;
