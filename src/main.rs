@@ -20,7 +20,10 @@ use bench_cli::{
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use linkage::linkage::Interrupt;
-use linkage::render::{Colouring, PictureWriter, Projection, StepSelection};
+use linkage::render::{
+    draw_with_shared_scale, Colouring, PictureWriter, Projection, RenderOptions, StepSelection,
+    VariantPictures,
+};
 use linkage::scene::batch::{self, JobSettings, Ran, SlurmOptions};
 use linkage::scene::load_scene;
 use rayon::prelude::*;
@@ -565,6 +568,8 @@ fn run_scenes(
     let mut failed = 0;
     let mut written: Vec<(String, PathBuf)> = Vec::new();
     let mut rows = Vec::with_capacity(results.len());
+    // The drawn variants of each sweep, redrawn below with one scale for all of them.
+    let mut variants: Vec<(String, VariantPictures)> = Vec::new();
     for (job, (ran, row)) in mine.iter().zip(results) {
         rows.push(row);
         let path = &job.scene;
@@ -572,8 +577,24 @@ fn run_scenes(
             Some(k) => format!("{} [{k}]", path.display()),
             None => path.display().to_string(),
         };
+        if let (Some(_), Ran::Solved { world, .. } | Ran::Drawn { world }) = (job.variant, &ran) {
+            let p = &world.pictures;
+            if p.png || p.gif || p.gltf {
+                variants.push((
+                    job.name.clone(),
+                    VariantPictures {
+                        dir: job.folder(out),
+                        options: RenderOptions {
+                            step_fraction: world.plots.step_fraction,
+                            ..RenderOptions::from_settings(p)
+                        },
+                        gltf: p.gltf,
+                    },
+                ));
+            }
+        }
         match ran {
-            Ran::Drawn => say!(
+            Ran::Drawn { .. } => say!(
                 "drew  {shown} -> {}: from the complete results there, without solving (--rerun solves it again)",
                 job.folder(out).display()
             ),
@@ -640,6 +661,28 @@ fn run_scenes(
                 } else {
                     say!("FAIL  {shown}: {msg}");
                 }
+            }
+        }
+    }
+    // Each sweep's variants drawn again with one magnification and one colour range.
+    let mut sweeps: Vec<&str> = Vec::new();
+    for (name, _) in &variants {
+        if !sweeps.contains(&name.as_str()) {
+            sweeps.push(name);
+        }
+    }
+    for name in sweeps {
+        let group: Vec<VariantPictures> = variants
+            .iter()
+            .filter(|(n, _)| n == name)
+            .map(|(_, v)| v.clone())
+            .collect();
+        match draw_with_shared_scale(&group, Interrupt::on(&STOP)) {
+            Ok(Some(scale)) => say!("scale {name}: {}", scale.describe()),
+            Ok(None) => {}
+            Err(e) => {
+                failed += 1;
+                say!("FAIL  {name}: drawing the variants with one scale: {e}");
             }
         }
     }
@@ -868,6 +911,8 @@ fn render(a: &RenderArgs) -> Result<()> {
         interrupt: Interrupt::on(&STOP),
         // Read from the results folder's plot settings by `draw_read_run_to`.
         step_fraction: false,
+        // A sweep variant's shared scale is read from its folder by `render_run_to`.
+        shared: None,
     };
     let out = a.out.clone().unwrap_or_else(|| a.dir.clone());
     if a.out.is_some() {

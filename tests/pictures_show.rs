@@ -452,3 +452,102 @@ fn a_contact_scene_is_magnified_as_far_as_nothing_crosses_what_it_touches() {
         deepest_excess(factors[i - 1])
     );
 }
+
+/// Two 3D trusses (unit cubes of 12 edges and a diagonal on each face, no surface patches),
+/// the second 1.05 m beside the first along x, each held at its four bottom nodes and pressed
+/// down at a top node.
+fn two_trusses(dir: &Path) -> PathBuf {
+    let cube = |x0: f64| -> String {
+        let mut nodes = String::new();
+        for (x, y, z) in [
+            (0., 0., 0.),
+            (1., 0., 0.),
+            (1., 0., 1.),
+            (0., 0., 1.),
+            (0., 1., 0.),
+            (1., 1., 0.),
+            (1., 1., 1.),
+            (0., 1., 1.),
+        ] {
+            nodes.push_str(&format!("{} {y} {z}\n", x0 + x));
+        }
+        nodes
+    };
+    std::fs::write(dir.join("left.nodes"), cube(0.0)).unwrap();
+    std::fs::write(dir.join("right.nodes"), cube(1.05)).unwrap();
+    std::fs::write(
+        dir.join("cube.links"),
+        "1 2\n2 3\n3 4\n4 1\n5 6\n6 7\n7 8\n8 5\n1 5\n2 6\n3 7\n4 8\n1 3\n5 7\n1 6\n2 7\n3 8\n4 5\n",
+    )
+    .unwrap();
+    let body = |name: &str| {
+        format!(
+            "[[bodies]]\nname = \"{name}\"\nnodes = \"{name}.nodes\"\nlinks = \"cube.links\"\nmaterial = \"steel\"\n\n\
+             [[bodies.supports]]\nnodes = [1, 2, 3, 4]\nfix = [\"x\", \"y\", \"z\"]\n\n\
+             [[bodies.loads]]\nnodes = [7]\nforce = [0.0, -1000.0, 0.0]\n\n"
+        )
+    };
+    let text = format!(
+        "name = \"trusses\"\nsteps = 1\n\n[[materials]]\nname = \"steel\"\nyoungs_modulus = 200e9\narea = 1e-4\n\n{}{}",
+        body("left"),
+        body("right")
+    );
+    let path = dir.join("trusses.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn a_frame_of_two_3d_trusses_without_patches_shows_each_in_its_own_colour() {
+    let out = tempfile::tempdir().unwrap();
+    let world = load_scene(&two_trusses(out.path())).unwrap();
+    run(&world, out.path(), &|| {}).unwrap();
+    let results = RunResults::read(&out.path().join(&world.name)).unwrap();
+    assert_eq!(results.model.bodies.len(), 2);
+    assert!(results
+        .model
+        .bodies
+        .iter()
+        .all(|b| b.dimension == 3 && b.patches.is_empty()));
+    let o = options();
+    let ext = RunExtent::of_run(&results, None);
+    let frame = draw_frame(&results.model, results.steps.last().unwrap(), &ext, &o).unwrap();
+    let tol = 2.0 / 255.0;
+    let (a, b) = (
+        count(&frame, BODY_COLOURS[0], tol),
+        count(&frame, BODY_COLOURS[1], tol),
+    );
+    eprintln!("{a} and {b} pixels of the two body colours");
+    assert!(
+        a > 200 && b > 200,
+        "{a} and {b} pixels of the two body colours"
+    );
+    // Each colour where its truss is: the mean pixel of the first colour left of the
+    // second's by at least a third of the trusses' on-screen distance.
+    let view = view_for(&o, &ext);
+    let centre_on_screen = |k: usize| {
+        let nodes = &results.model.bodies[k].nodes;
+        let n = nodes.len() as f32;
+        nodes.iter().map(|p| view.project(&v3(p))[0]).sum::<f32>() / n
+    };
+    let mean_x = |c: Rgb| {
+        let (mut sx, mut n) = (0.0f32, 0.0f32);
+        for y in 0..frame.height() {
+            for x in 0..frame.width() {
+                if near(frame.rgb(x, y).unwrap(), c, tol) {
+                    sx += x as f32;
+                    n += 1.0;
+                }
+            }
+        }
+        sx / n
+    };
+    let (ca, cb) = (mean_x(BODY_COLOURS[0]), mean_x(BODY_COLOURS[1]));
+    let (ta, tb) = (centre_on_screen(0), centre_on_screen(1));
+    eprintln!("colours at x = {ca}, {cb}; trusses at x = {ta}, {tb}");
+    assert!(tb - ta > 60.0, "the trusses {ta} and {tb} apart on screen");
+    assert!(
+        (ca - ta).abs() < (tb - ta) / 3.0 && (cb - tb).abs() < (tb - ta) / 3.0,
+        "colours at {ca}, {cb}; trusses at {ta}, {tb}"
+    );
+}

@@ -54,6 +54,9 @@ pub struct RunExtent {
     /// [`crate::render::timed_delays`] chose: the frame titles state it. `None` (measured
     /// extents): no GIF timed by the run's times, nothing stated.
     pub gif_slowdown: Option<Real>,
+    /// The magnification and colour ranges are shared by this many variants of a sweep
+    /// ([`crate::render::SharedScale`]): the frames say so. `None`: the run's own.
+    pub shared_by: Option<usize>,
 }
 
 fn vec3(p: &[Real]) -> Vector3<Real> {
@@ -255,6 +258,7 @@ impl RunExtent {
             last_step,
             up: model.up.map_or_else(Vector3::y, |u| vec3(&u)),
             gif_slowdown: None,
+            shared_by: None,
         }
     }
 }

@@ -27,6 +27,7 @@ pub use self::run_pictures::{
     draw_read_run_to, draw_run, read_run_to_render, render_run, render_run_to, select_steps,
     PictureWriter, RenderReport,
 };
+pub use self::shared_scale::{draw_with_shared_scale, SharedScale, VariantPictures, PICTURE_SCALE};
 
 mod animated_run;
 mod camera;
@@ -54,5 +55,6 @@ mod raster;
 mod replot;
 pub mod report;
 mod run_pictures;
+mod shared_scale;
 mod text;
 pub mod viewer;

@@ -134,6 +134,10 @@ pub struct RenderOptions {
     /// The results' load factor is the step fraction, not what the schedules say
     /// ([`crate::scene::PlotSettings::step_fraction`]): the title calls it so.
     pub step_fraction: bool,
+    /// The magnification and colour ranges shared by the variants of a sweep (see
+    /// [`crate::render::SharedScale`]): used instead of the run's own (and of
+    /// `magnification`). `None`: the run's own.
+    pub shared: Option<crate::render::SharedScale>,
 }
 
 impl Default for RenderOptions {
@@ -154,6 +158,7 @@ impl Default for RenderOptions {
             supersampling: 2,
             interrupt: Interrupt::default(),
             step_fraction: false,
+            shared: None,
         }
     }
 }

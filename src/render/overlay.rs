@@ -77,6 +77,9 @@ pub struct Caption {
     pub peak_stress: Option<(Real, Option<Real>)>,
     /// Displacement magnification.
     pub magnification: Real,
+    /// The magnification and colour range are shared by this many variants of a sweep
+    /// (stated after the magnification); `None`: the run's own.
+    pub shared_by: Option<usize>,
     /// Colour bar: (title, limit in Pa) when colouring by stress.
     pub stress_bar: Option<(String, Real)>,
     /// Largest applied force over the run, N (0: no force legend).
@@ -187,6 +190,10 @@ pub fn draw_overlay(frame: &mut Frame, layout: &Layout, c: &Caption) {
             "displacements drawn ×{}",
             fmt_magnification(c.magnification)
         )
+    };
+    let mag = match c.shared_by {
+        Some(n) => format!("{mag}  ·  {}", shared_note(n, c.stress_bar.is_some())),
+        None => mag,
     };
     draw_text(&mut frame.pixmap, &mag, x, h - 24.0 * ui, small, INK);
 
@@ -441,6 +448,16 @@ fn fmt_load(f: Real) -> String {
     }
 }
 
+/// What a frame says of a scale shared by `n` variants of a sweep (`colours`: the frame has a
+/// stress colour bar).
+pub fn shared_note(n: usize, colours: bool) -> String {
+    if colours {
+        format!("magnification and colour range shared by the sweep's {n} variants")
+    } else {
+        format!("magnification shared by the sweep's {n} variants")
+    }
+}
+
 fn fmt_magnification(m: Real) -> String {
     if m >= 1.0 && m == m.round() {
         format!("{m:.0}")
@@ -470,6 +487,7 @@ mod tests {
             broken: None,
             peak_stress: None,
             magnification: 1.0,
+            shared_by: None,
             stress_bar: None,
             max_force: 0.0,
             max_contact: 0.0,

@@ -213,6 +213,7 @@ pub fn draw_frame(
                 .then_some(facts.broken),
             peak_stress: facts.peak,
             magnification: extent.magnification,
+            shared_by: extent.shared_by,
             stress_bar,
             max_force: extent.max_force,
             max_contact: extent.max_contact,

@@ -5,7 +5,7 @@ use crate::render::gif::LAST_FRAME_DELAY;
 use crate::render::gltf::write_gltf;
 use crate::render::{
     draw_frame, stored_time, timed_delays, Frame, GifAnimation, RenderError, RenderOptions,
-    RunExtent, StepSelection,
+    RunExtent, SharedScale, StepSelection,
 };
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::publish::{publish_keeping, remove_stale, staging_dir};
@@ -116,8 +116,16 @@ pub fn draw_read_run_to(
     out: &Path,
     options: &RenderOptions,
 ) -> Result<RenderReport, RenderError> {
+    // A sweep variant's frames keep the scale the sweep's variants share, unless another
+    // magnification is asked for.
+    let shared = match (&options.shared, options.magnification) {
+        (Some(s), _) => Some(s.clone()),
+        (None, None) => SharedScale::read(dir),
+        (None, Some(_)) => None,
+    };
     let options = &RenderOptions {
         step_fraction: options.step_fraction || PlotSettings::read(dir).step_fraction,
+        shared,
         ..options.clone()
     };
     if out != dir {
@@ -130,7 +138,8 @@ pub fn draw_read_run_to(
 }
 
 /// Draw `run` into the folder `dir` as [`render_run`] does: `png/NNNN.png` per step
-/// `options.steps` selects and `anim.gif` of them, as `options` ask.
+/// `options.steps` selects and `anim.gif` of them, as `options` ask (with the scale of
+/// `options.shared` when given).
 pub fn draw_run(
     run: &RunResults,
     dir: &Path,
@@ -138,7 +147,10 @@ pub fn draw_run(
 ) -> Result<RenderReport, RenderError> {
     options.check()?;
     let steps = pick_steps(&run.step_numbers(), dir, &options.steps)?;
-    let extent = RunExtent::of_run(run, options.magnification);
+    let extent = match &options.shared {
+        Some(scale) => scale.extent_of(run),
+        None => RunExtent::of_run(run, options.magnification),
+    };
     let report = RenderReport {
         steps: steps.clone(),
         magnification: extent.magnification,

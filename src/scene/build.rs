@@ -16,6 +16,7 @@ use crate::scene::import::{read_model, NodeGroup};
 use crate::scene::inline_files::InlineFiles;
 use crate::scene::obstacles::{contact_settings, obstacle_from};
 use crate::scene::paper_files::{self, PaperFileError};
+use crate::scene::plot_settings::NamedSupport;
 use crate::scene::prepared_body::prepared_geometry;
 use crate::scene::pressures::add_pressure;
 use crate::scene::selector::{far_nearest_warning, select_nodes_in, vector};
@@ -275,6 +276,7 @@ fn build_world_from(
     let mut solids = std::collections::BTreeMap::new();
     let mut warnings = Vec::new();
     let mut found = Vec::new();
+    let mut named_supports: Vec<NamedSupport> = Vec::new();
     for b in &spec.bodies {
         let mut notes = BodyNotes::default();
         let steps = match &dynamics {
@@ -314,6 +316,22 @@ fn build_world_from(
         }
         found.extend(notes.found);
         warnings.extend(notes.warnings);
+        for mut s in notes.named_supports {
+            if named_supports
+                .iter()
+                .any(|o: &NamedSupport| o.name == s.name)
+            {
+                return Err(at(
+                    b.span(),
+                    format!(
+                        "support '{}' is named twice: support names must differ in the scene",
+                        s.name
+                    ),
+                ));
+            }
+            s.body_index = bodies.len();
+            named_supports.push(s);
+        }
         // A model file's materials follow the scene's, with their densities.
         let density: Vec<Option<crate::Real>> =
             density.iter().copied().chain(notes.densities).collect();
@@ -391,7 +409,7 @@ fn build_world_from(
             friction_settings(c.get_ref(), &names, c.span()).map_err(|(span, e)| at(span, e))?;
     }
     let obstacle_names: Vec<&str> = obstacles.iter().map(|o| o.name.as_str()).collect();
-    let plots = PlotSettings::from_spec(&spec.output, &bodies, &obstacle_names)
+    let plots = PlotSettings::from_spec(&spec.output, &bodies, &obstacle_names, &named_supports)
         .map_err(|e| at(output_span, e))?;
     let members = bodies.iter().map(|b| b.members.len()).sum();
     let output = OutputSettings {
@@ -663,6 +681,8 @@ struct BodyNotes {
     /// Slips found while building the body (a far `nearest` point, a load partly on held
     /// directions), for the run's warnings.
     warnings: Vec<String>,
+    /// The supports with a `name` (for `[output] plot`).
+    named_supports: Vec<NamedSupport>,
 }
 
 fn build_body(
@@ -1056,6 +1076,15 @@ fn build_body(
             )));
         }
         let schedule = schedule_of(&sp.schedule, false).map_err(fail)?;
+        if let Some(name) = &sp.name {
+            notes.named_supports.push(NamedSupport {
+                name: name.clone(),
+                body: spec.name.clone(),
+                body_index: 0,
+                nodes: nodes.clone(),
+                displacement: [displacement.x, displacement.y, displacement.z],
+            });
+        }
         for node in nodes {
             body.supports.push(Support {
                 node,

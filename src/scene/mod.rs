@@ -14,7 +14,9 @@ pub use self::dynamic_simulation::{solve_time_step, DynamicSimulation, MAX_TIME_
 pub use self::inline_files::InlineFiles;
 pub use self::model_file::{ModelBody, ModelFile, ModelObstacle, SupportedNode, HALF_SPACE_PATCH};
 pub use self::pictures::{PictureSettings, MAX_FRAME_SIDE};
-pub use self::plot_settings::{load_name, PlotNode, PlotSettings, PLOT_SETTINGS};
+pub use self::plot_settings::{
+    load_name, NamedSupport, PlotNode, PlotPlace, PlotSettings, PLOT_SETTINGS,
+};
 pub use self::prepared_body::{prepare_file, read_outline, write_prepared};
 pub use self::result_format::{ResultFormat, NPZ_ABOVE_MEMBERS};
 pub use self::results::{

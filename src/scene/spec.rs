@@ -478,6 +478,8 @@ pub struct PlaneSpec {
 #[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SupportSpec {
+    /// A name for `[output] plot = { support = "NAME" }` (unique in the scene; optional).
+    pub name: Option<String>,
     /// 1-based node numbers.
     pub nodes: Option<Vec<i64>>,
     /// See [`SelectorSpec`].
@@ -596,6 +598,21 @@ pub struct OutputSpec {
     /// The obstacle whose push is the load: the load–displacement plot shows the force the
     /// bodies receive from it against its travel.
     pub plot_obstacle: Option<String>,
+    /// The place whose force the load–displacement plot shows against its displacement: a
+    /// named support, or nodes of a body.
+    pub plot: Option<PlotSpec>,
+}
+
+/// `[output] plot = { support = "NAME" }` or `plot = { body = "NAME", nodes = [..] }`.
+#[derive(Debug, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct PlotSpec {
+    /// A support's `name`.
+    pub support: Option<String>,
+    /// The body of `nodes` (default: the first body).
+    pub body: Option<String>,
+    /// 1-based node numbers of `body`.
+    pub nodes: Option<Vec<i64>>,
 }
 
 macro_rules! selector_of {

@@ -115,8 +115,14 @@ fn write_bytes(path: &Path, bytes: std::io::Result<Vec<u8>>) -> Result<(), RunEr
 
 /// Write `model.json` (or `model.npz`) of `world` into `dir` and return it with the seconds
 /// spent. It depends on nothing solved, so the driver writes it while the steps are solved.
+/// The plot settings ([`crate::scene::PLOT_SETTINGS`]) are kept beside it in every run, with
+/// pictures or without, so `linkage render DIR` draws the plots the scene asks for.
 pub(crate) fn write_model(world: &World, dir: &Path) -> Result<(ModelFile, f64), RunError> {
     let t = Instant::now();
+    world.plots.write(dir).map_err(|source| RunError::Write {
+        path: dir.join(crate::scene::PLOT_SETTINGS),
+        source,
+    })?;
     let path = dir.join(world.output.format.model_file());
     let model = ModelFile::new(world);
     match world.output.format {

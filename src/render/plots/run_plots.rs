@@ -2,7 +2,7 @@
 
 use crate::render::plots::{
     breaks, contact_force_time, contact_forces, energies, load_displacement, obstacle_force,
-    reaction, residuals, PlotError, WrittenPlot,
+    place_force, reaction, residuals, PlotError, WrittenPlot,
 };
 use crate::scene::{PlotSettings, RunResults, Summary};
 use std::path::Path;
@@ -12,7 +12,8 @@ pub const PLOTS: &str = "plots";
 
 /// Write the plots of the run with `summary` and stored steps `run` into `dir/plots/`: always
 /// the load–displacement curve (the force from `settings.obstacle` against its travel when
-/// it names a moving obstacle; and with `settings.node` the reaction total); the contact
+/// it names a moving obstacle, the force at `settings.place` against its displacement when
+/// it is given; and with `settings.node` the reaction total); the contact
 /// forces when a pair touched, the Newton residuals when a step was nonlinear, the breaks when
 /// members broke; for a dynamic scene the energies against time, and the total contact force
 /// against time when something touched. Each as PNG, SVG and the CSV of its points, written atomically.
@@ -31,8 +32,13 @@ pub fn plot_run(
         .obstacle
         .as_deref()
         .and_then(|name| obstacle_force(summary, run, name));
+    let by_place = settings
+        .place
+        .as_ref()
+        .and_then(|place| place_force(&summary.scene, run, place));
     let load = settings.load_name();
     let mut charts = vec![by_obstacle
+        .or(by_place)
         .unwrap_or_else(|| load_displacement(summary, run, settings.node.as_ref(), load))];
     if settings.node.is_some() {
         charts.extend(reaction(&summary.scene, run, load));

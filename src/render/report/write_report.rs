@@ -6,7 +6,7 @@ use crate::render::report::job_files::JobFiles;
 use crate::render::report::scene_page::scene_page;
 use crate::render::report::sweep_plots::{sweep_section, write_sweep_plots};
 use crate::render::viewer::{viewer_data, viewer_section, VIEWER_BUDGET};
-use crate::render::{stored_time, AnimatedRun, RunExtent};
+use crate::render::{stored_time, AnimatedRun, RunExtent, SharedScale};
 use crate::scene::atomic_file::write_atomically;
 use crate::scene::batch::Row;
 use crate::scene::{PlotSettings, RunResults};
@@ -34,7 +34,10 @@ pub fn write_report_of(
     for (row, files) in &jobs {
         if !files.folder.is_empty() && only.is_none_or(|(j, _)| j == row.job) {
             let dir = files.dir(out);
-            let viewer = viewer_of(&dir, only.and_then(|(_, run)| run));
+            let mut viewer = viewer_of(&dir, only.and_then(|(_, run)| run));
+            if let Some(scale) = SharedScale::read(&dir) {
+                viewer.insert_str(0, &shared_note(&scale));
+            }
             write_atomically(
                 &dir.join(REPORT),
                 scene_page(row, files, &viewer).as_bytes(),
@@ -55,17 +58,41 @@ pub fn write_report_of(
         n => format!("linkage: {} and {} more", scenes[..3].join(", "), n - 3),
     };
     let sweeps = write_sweep_plots(out, rows).map_err(std::io::Error::other)?;
+    let mut after = String::new();
+    // One note per sweep whose variants share a scale (read from its first variant that has
+    // one).
+    let mut noted: Vec<&str> = Vec::new();
+    for (row, files) in &jobs {
+        if row.values.is_empty() || files.folder.is_empty() || noted.contains(&row.scene.as_str()) {
+            continue;
+        }
+        if let Some(scale) = SharedScale::read(&files.dir(out)) {
+            noted.push(row.scene.as_str());
+            after.push_str(&format!(
+                "<h2>{}: one scale for all variants</h2>\n{}",
+                escape(&row.scene),
+                shared_note(&scale)
+            ));
+        }
+    }
+    after.push_str(&sweep_section(&sweeps));
     let path = out.join(REPORT);
-    write_atomically(
-        &path,
-        batch_page(&title, &jobs, &sweep_section(&sweeps)).as_bytes(),
-    )?;
+    write_atomically(&path, batch_page(&title, &jobs, &after).as_bytes())?;
     Ok(path)
+}
+
+/// The note saying that a sweep's variants share `scale`.
+fn shared_note(scale: &SharedScale) -> String {
+    let mut text = scale.describe();
+    if let Some(first) = text.get(..1) {
+        text.replace_range(..1, &first.to_uppercase());
+    }
+    format!("<p class=\"note shared-scale\">{}.</p>\n", escape(&text))
 }
 
 /// The 3D view of the results in `dir` (`run`, its stored steps, when given, else read
 /// back; decimated to [`VIEWER_BUDGET`], displacements magnified as the pictures do by
-/// default), or a note why there is none.
+/// default, or by the magnification a sweep's variants share), or a note why there is none.
 fn viewer_of(dir: &Path, run: Option<&RunResults>) -> String {
     let read;
     let run = match run {
@@ -77,7 +104,11 @@ fn viewer_of(dir: &Path, run: Option<&RunResults>) -> String {
     };
     match run {
         Ok(run) => {
-            let magnification = RunExtent::of_run(run, None).magnification;
+            // A sweep variant's view has the magnification the variants share.
+            let magnification = SharedScale::read(dir).map_or_else(
+                || RunExtent::of_run(run, None).magnification,
+                |s| s.magnification,
+            );
             let mut animation = AnimatedRun::of_run(run, magnification, VIEWER_BUDGET, stored_time);
             animation.load_name = PlotSettings::read(dir).load_name();
             viewer_section(&viewer_data(&animation))

@@ -17,7 +17,10 @@ pub enum Ran {
     Skipped,
     /// Its complete results were there already, and the pictures or VTK files asked for
     /// (`--png`, `--vtk`) were drawn from them without solving.
-    Drawn,
+    Drawn {
+        /// The world whose results were drawn.
+        world: Box<World>,
+    },
     /// It ran and every step was solved.
     Solved {
         /// The world it ran.
@@ -124,7 +127,15 @@ pub fn run_job(
         }
         // Asked for pictures: drawn from the stored results, not solved again.
         return match draw_stored(&world, &summary, &folder, draw) {
-            Ok(()) => (Ran::Drawn, row("ok".into())),
+            Ok(()) => {
+                let row = row("ok".into());
+                (
+                    Ran::Drawn {
+                        world: Box::new(world),
+                    },
+                    row,
+                )
+            }
             Err(why) => (Ran::Failed(why.clone()), row(format!("failed: {why}"))),
         };
     }
