@@ -399,3 +399,177 @@ fn cylinder_rim_over_nodes_presses_them_down() {
         assert!(differ < 1e-7, "{differ:e}");
     }
 }
+
+/// The open tube of `cylindrical_shell` (radius 0.1 m, length 0.4 m, 5 rings of 16 nodes, E A =
+/// 2e7 N), clamped at both end rings, as scene text with `rest` (obstacles, loads) after it.
+fn tube_scene(rest: &str) -> String {
+    let ends: Vec<String> = (1..=16).chain(65..=80).map(|n| n.to_string()).collect();
+    format!(
+        r#"name = "tube"
+steps = 1
+[[materials]]
+name = "steel"
+youngs_modulus = 2e11
+area = 1e-4
+[[bodies]]
+name = "tube"
+cylindrical_shell = {{ radius = 0.1, length = 0.4, rings = 5, sectors = 16 }}
+[[bodies.supports]]
+nodes = [{}]
+fix = ["x", "y", "z"]
+{rest}
+"#,
+        ends.join(", ")
+    )
+}
+
+/// A narrow pyramid (a closed OBJ mesh) whose apex is at `apex` and whose axis runs from the
+/// apex along `axis` (unit) for 0.08 m to a square base of half width 0.01 m, its sides along
+/// `e_x` and `e_x × axis`.
+fn pyramid_obj(apex: [f64; 3], axis: [f64; 3]) -> String {
+    let side = [0.0, -axis[2], axis[1]];
+    let mut text = format!("v {} {} {}\n", apex[0], apex[1], apex[2]);
+    for (a, b) in [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)] {
+        let v: Vec<f64> = (0..3)
+            .map(|k| {
+                let e_x = if k == 0 { 1.0 } else { 0.0 };
+                apex[k] + 0.08 * axis[k] + 0.01 * (a * e_x + b * side[k])
+            })
+            .collect();
+        text += &format!("v {} {} {}\n", v[0], v[1], v[2]);
+    }
+    text + "f 1 2 3\nf 1 3 4\nf 1 4 5\nf 1 5 2\nf 2 5 4 3\n"
+}
+
+/// A sharp obstacle point pressing an open shell, from outside and from inside (an open shell
+/// has no inside: the point presses the patch it crossed since the last solved state, from
+/// either side). The apex of a narrow pyramid (a mesh obstacle's vertex) lies over the middle
+/// of the ring segment between nodes 33 and 34 (ring 2 of the clamped tube, the middle ring;
+/// sectors 0 and 1), 1 µm off the shell along the segment's radial normal n (the flat cell's
+/// normal, at 11.25°), and travels 5 µm along −n (from outside) or +n (from inside, the pyramid
+/// in the tube). Before, the point passed through the shell between its nodes, nothing held it
+/// and nothing said so. Now: the shell takes the force F = 4 µm / (c + 1/k), with c the
+/// shell's compliance for a force at the segment's middle, half on each node (from the run
+/// with that load and no obstacle), and k the shell's penalty; to 1e-4 (the patch's normal
+/// turns as the shell dents, by the dent over a member, ~1e-5 rad). The supports react with F
+/// (1e-8). The dent is symmetric about the middle ring's plane (x = 0.2 m) and about the plane
+/// through the axis and the segment's middle (1e-4 of the largest displacement), and the
+/// dents from outside and inside are opposite (1e-4). The same on the condensed and the
+/// coupled path.
+#[test]
+fn a_pyramid_apex_pressing_an_open_tube_between_nodes_dents_it_from_either_side() {
+    let phi = std::f64::consts::PI / 16.0;
+    let n = [0.0, phi.cos(), phi.sin()];
+    let radius = 0.1 * phi.cos();
+    let middle = [0.2, radius * n[1], radius * n[2]];
+    let (gap, travel) = (1e-6, 5e-6);
+    // The compliance: 1 N at the segment's middle along −n, half on each node.
+    let load = format!(
+        "[[bodies.loads]]\nnodes = [33, 34]\nforce = [0.0, {}, {}]\n",
+        -0.5 * n[1],
+        -0.5 * n[2]
+    );
+    let unit = last_step(&[], &tube_scene(&load), true);
+    let u = &unit.bodies[0].displacements;
+    let c = -(0..3).map(|k| (u[32][k] + u[33][k]) * n[k]).sum::<f64>() / 2.0;
+    assert!(c > 0.0, "{c}");
+    let world = load_scene_text(&tube_scene(""));
+    let k = linkage::contact::default_penalty(&world.bodies[0]);
+    let expected = (travel - gap) / (c + 1.0 / k);
+    eprintln!("compliance {c:.6e} m/N, penalty {k:.6e} N/m: F = {expected:.6e} N");
+    let mut dents: Vec<Vec<Vec<f64>>> = Vec::new();
+    for outside in [true, false] {
+        let s = if outside { 1.0 } else { -1.0 };
+        let apex: [f64; 3] = std::array::from_fn(|k| middle[k] + s * gap * n[k]);
+        let axis: [f64; 3] = std::array::from_fn(|k| s * n[k]);
+        let obj = pyramid_obj(apex, axis);
+        let obstacle = format!(
+            "[[obstacles]]\nname = \"pyramid\"\nshape = \"mesh\"\nfile = \"pyramid.obj\"\ntravel = [0.0, {}, {}]\n",
+            -s * travel * n[1],
+            -s * travel * n[2]
+        );
+        let scene = tube_scene(&obstacle);
+        let mut results = Vec::new();
+        for condense in [true, false] {
+            let step = last_step(&[("pyramid.obj", &obj)], &scene, condense);
+            let body = step.bodies[0].clone();
+            let f = total(&body);
+            let along = -s * (0..3).map(|k| f[k] * n[k]).sum::<f64>();
+            let reacted: Vec<f64> = (0..3)
+                .map(|k| body.reactions.iter().map(|r| r.force[k]).sum::<f64>())
+                .collect();
+            eprintln!(
+                "outside {outside} condense {condense}: contact force {f:?} N ({along:.6e} N along ∓n), reactions {reacted:?} N, {} contact entries",
+                body.contacts.len()
+            );
+            assert!(
+                body.contacts.iter().all(|e| e.with == "pyramid"),
+                "{:?}",
+                body.contacts
+            );
+            assert!(
+                (along - expected).abs() <= 1e-4 * expected,
+                "outside {outside} condense {condense}: {along} against {expected}"
+            );
+            for kk in 0..3 {
+                assert!(
+                    (f[kk] + reacted[kk]).abs() <= 1e-8 * expected,
+                    "{f:?} {reacted:?}"
+                );
+            }
+            // Symmetry: ring r ↔ 4 − r with u_x turned; sector s ↔ 1 − s reflected in the
+            // plane through the axis and n (normal t = (0, −sin φ, cos φ)).
+            let u = &body.displacements;
+            let largest = u.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+            let t = [0.0, -phi.sin(), phi.cos()];
+            let (mut across_x, mut across_n) = (0.0f64, 0.0f64);
+            for r in 0..5 {
+                for q in 0..16 {
+                    let i = r * 16 + q;
+                    let j = (4 - r) * 16 + q;
+                    across_x = across_x
+                        .max((u[i][0] + u[j][0]).abs())
+                        .max((u[i][1] - u[j][1]).abs())
+                        .max((u[i][2] - u[j][2]).abs());
+                    let m = r * 16 + (17 - q) % 16;
+                    let dot: f64 = (0..3).map(|kk| u[i][kk] * t[kk]).sum();
+                    for kk in 0..3 {
+                        let reflected = u[i][kk] - 2.0 * dot * t[kk];
+                        across_n = across_n.max((reflected - u[m][kk]).abs());
+                    }
+                }
+            }
+            eprintln!(
+                "  symmetry: across x = 0.2 {:.3e}, across the plane of n {:.3e}",
+                across_x / largest,
+                across_n / largest
+            );
+            assert!(across_x <= 1e-4 * largest && across_n <= 1e-4 * largest);
+            results.push(body);
+        }
+        assert!(paths_differ(&results[0], &results[1]) <= 1e-6);
+        dents.push(results.swap_remove(0).displacements);
+    }
+    let largest = dents[0]
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let opposite = dents[0]
+        .iter()
+        .flatten()
+        .zip(dents[1].iter().flatten())
+        .fold(0.0f64, |m, (a, b)| m.max((a + b).abs()));
+    eprintln!(
+        "dents from outside and inside differ from opposite by {:.3e}",
+        opposite / largest
+    );
+    assert!(opposite <= 1e-4 * largest);
+}
+
+/// The world of scene text `text` (no files beside it).
+fn load_scene_text(text: &str) -> linkage::scene::World {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    load_scene(&path).unwrap()
+}

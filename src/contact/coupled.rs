@@ -10,6 +10,7 @@ use crate::linalg::{CholeskyError, LowRankCorrection, SparseColumn};
 use crate::linkage::body_state::{fill_tangent, internal_force_vector, norm};
 use crate::linkage::dynamics::InertiaTerm;
 use crate::linkage::line_search::backtrack;
+use crate::linkage::{add_follower_load_stiffness, pair_members};
 use crate::linkage::{Body, Convergence, PhaseTimes, SolverUsed, StiffnessAssembly};
 use crate::Real;
 use nalgebra::Vector3;
@@ -157,13 +158,15 @@ impl CoupledSolver {
                 }
             }
             let offset = self.system.offsets[b];
+            // Nodal loads, and following pressures on the faces deformed by `u`.
+            let forces = p.applied(b, &part.u);
             for (i, &dof) in part.dofs.free.iter().enumerate() {
-                r[offset + i] = p.forces[b][dof] + fc[dof] - internal[dof];
+                r[offset + i] = forces[dof] + fc[dof] - internal[dof];
             }
             for &dof in &part.dofs.supported {
-                reacted += (internal[dof] - p.forces[b][dof] - fc[dof]).powi(2);
+                reacted += (internal[dof] - forces[dof] - fc[dof]).powi(2);
             }
-            applied += p.forces[b].iter().map(|f| f * f).sum::<Real>();
+            applied += forces.iter().map(|f| f * f).sum::<Real>();
             contact += fc.iter().map(|f| f * f).sum::<Real>();
         }
         let scale = applied
@@ -302,6 +305,16 @@ impl CoupledSolver {
         self.couple(parts, evaluated, times)?;
         for (part, body) in parts.iter_mut().zip(p.bodies) {
             fill_tangent(body, &part.assembly, &part.u, &mut part.local);
+            // A following pressure's load stiffness, as the body's own Newton takes it.
+            if !body.pressures.is_empty() && body.newton.load_stiffness {
+                add_follower_load_stiffness(
+                    body,
+                    (&part.dofs, &part.assembly, &pair_members(body)),
+                    &part.u,
+                    p.time,
+                    &mut part.local,
+                );
+            }
         }
         let locals: Vec<Vec<Real>> = parts
             .iter_mut()

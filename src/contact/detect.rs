@@ -63,6 +63,9 @@ pub(crate) struct Geometry {
     /// Per open shell (empty for other bodies), per body, per node: the side of the shell the
     /// node started the step on (+1 in front of its patches, −1 behind, 0 not known).
     pub(crate) sides: Vec<Vec<Vec<i8>>>,
+    /// Per open shell (empty for other bodies), per obstacle, per sharp point of the
+    /// obstacle: the side of the shell the point started the step on (as [`Geometry::sides`]).
+    pub(crate) point_sides: Vec<Vec<Vec<i8>>>,
     /// Per body, how far behind it as an open shell a node may be and be held, m.
     pub(crate) shell_reach: Vec<Real>,
     /// The rigid obstacles, held in rapier.
@@ -111,6 +114,15 @@ impl Geometry {
                 _ => Vec::new(),
             })
             .collect();
+        let point_sides = patch_surfaces
+            .iter()
+            .map(|s| match s {
+                Some(s) if s.is_open() => {
+                    features.points.iter().map(|p| vec![0; p.len()]).collect()
+                }
+                _ => Vec::new(),
+            })
+            .collect();
         let shell_reach = bodies
             .iter()
             .map(|b| SHELL_REACH_MEMBERS * 100.0 * penetration_tolerance(b))
@@ -121,6 +133,7 @@ impl Geometry {
             surfaces,
             patch_surfaces,
             sides,
+            point_sides,
             shell_reach,
             obstacles,
             features,
@@ -129,7 +142,8 @@ impl Geometry {
 
     /// Commit the obstacle crossings of the contacts `active` solved at the last state (the
     /// obstacles at `offsets` there, m), and take the nodes' positions there as the start of
-    /// the segments along which the next crossings are found.
+    /// the segments along which the next crossings are found; record the side of every open
+    /// shell each sharp obstacle point is on there ([`Geometry::record_point_sides`]).
     pub(crate) fn record_crossings(
         &mut self,
         bodies: &[Body],
@@ -137,6 +151,7 @@ impl Geometry {
         active: &ContactSet,
         offsets: Vec<Vector3<Real>>,
     ) {
+        self.record_point_sides(bodies, parts, active, &offsets);
         let start = bodies
             .iter()
             .enumerate()
@@ -147,6 +162,66 @@ impl Geometry {
             })
             .collect();
         self.features.record(active, start, offsets);
+    }
+
+    /// For every open shell, the side of it each sharp point of the obstacles (at `offsets`,
+    /// m) is on at the last solved state, with `active` the contacts solved there: as for the
+    /// nodes of other bodies ([`Geometry::record_sides`]), a point held by the shell keeps the
+    /// side it had, and one on the shell (within round-off) is not known and not held. An open
+    /// shell has no inside: a point presses it when it crossed it since, from either side.
+    fn record_point_sides(
+        &mut self,
+        bodies: &[Body],
+        parts: &[BodyPart],
+        active: &ContactSet,
+        offsets: &[Vector3<Real>],
+    ) {
+        let min_depth = min_depth(parts);
+        for shell in 0..self.patch_surfaces.len() {
+            let Some(surface) = self.patch_surfaces[shell].as_ref().filter(|s| s.is_open()) else {
+                continue;
+            };
+            let Some((mesh, _)) = surface.mesh(|n| position(bodies, parts, shell, n)) else {
+                continue;
+            };
+            for (o, points) in self.features.points.iter().enumerate() {
+                let (Some(offset), Some(sides)) =
+                    (offsets.get(o), self.point_sides[shell].get_mut(o))
+                else {
+                    continue;
+                };
+                for (point, q) in points.iter().enumerate() {
+                    let held = active.contacts.iter().any(|c| {
+                        c.body == shell
+                            && c.node == point
+                            && matches!(c.with, Target::Sharp { obstacle, .. } if obstacle == o)
+                    });
+                    if held && sides[point] != 0 {
+                        continue;
+                    }
+                    let s = surface
+                        .shell_side(&mesh, &(q + offset), |n| position(bodies, parts, shell, n));
+                    sides[point] = if s.distance <= min_depth || s.side == 0.0 {
+                        0
+                    } else if s.side > 0.0 {
+                        1
+                    } else {
+                        -1
+                    };
+                }
+            }
+        }
+    }
+
+    /// The side of open shell `shell` sharp point `point` of obstacle `o` started the step on
+    /// (+1 in front of its patches, −1 behind, 0 not known or not a shell).
+    pub(crate) fn point_side(&self, shell: usize, o: usize, point: usize) -> i8 {
+        self.point_sides
+            .get(shell)
+            .and_then(|s| s.get(o))
+            .and_then(|s| s.get(point))
+            .copied()
+            .unwrap_or(0)
     }
 
     /// Forget the crossings found since the last [`Geometry::record_crossings`] (an increment
@@ -481,10 +556,12 @@ impl Geometry {
     /// Every point along a sharp obstacle edge (2D: every corner of an obstacle's section) that
     /// lies inside a closed body, pressing the patch (2D: boundary segment) it entered through:
     /// the first one met going back along the obstacle's travel since the last solved state
-    /// (the nearest one when the obstacle has not moved). A sharp feature then presses between
-    /// the nodes of a coarse body. A point within `SHARP_REACH_MEMBERS` mean member lengths of a
-    /// node of the body that is itself inside the same obstacle (in `nodes`) is left out: the body follows the
-    /// obstacle with its own nodes there, and the point would count the same contact twice.
+    /// (the nearest one when the obstacle has not moved); and every such point on the other
+    /// side of an open shell from where it started the step, pressing the nearest patch. A
+    /// sharp feature then presses between the nodes of a coarse body. A point within
+    /// `SHARP_REACH_MEMBERS` mean member lengths of a node of the body that is itself inside the
+    /// same obstacle (in `nodes`) is left out: the body follows the obstacle with its own nodes
+    /// there, and the point would count the same contact twice.
     fn sharp_points_inside(
         &self,
         bodies: &[Body],
@@ -516,6 +593,27 @@ impl Geometry {
                     let patch = match (&meshes[b], &self.patch_surfaces[b], &polygons[b]) {
                         (Some((mesh, bounds)), Some(surface), _) if !surface.is_open() => {
                             entered_patch(mesh, bounds, &x, &back, min_depth)
+                        }
+                        (Some((mesh, [lo, hi])), Some(surface), _) => {
+                            // An open shell: the patch the point crossed since the last solved
+                            // state, from either side, as a node of another body does (not
+                            // beside the rim, and within the shell's reach).
+                            let started = self.point_side(b, o, point);
+                            let shell_reach = self.shell_reach[b];
+                            let near = (0..3).all(|k| {
+                                x[k] >= lo[k] - shell_reach && x[k] <= hi[k] + shell_reach
+                            });
+                            if started == 0 || !near {
+                                None
+                            } else {
+                                let s =
+                                    surface.shell_side(mesh, &x, |n| position(bodies, parts, b, n));
+                                (s.side * Real::from(started) < 0.0
+                                    && !s.on_rim
+                                    && s.distance > min_depth
+                                    && s.distance <= shell_reach)
+                                    .then_some(s.patch)
+                            }
                         }
                         (None, _, Some(polygon)) => entered_segment(polygon, &x, &back, min_depth),
                         _ => None,

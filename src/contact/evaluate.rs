@@ -315,12 +315,19 @@ fn on_sharp(
     let penalty = parts[body].penalty;
     if let Some(surface) = geometry.patch_surfaces[body].as_ref() {
         let [a, b, cc] = *surface.patches.get(patch)?;
-        let t = triangle_projection(
+        let mut t = triangle_projection(
             &q,
             &position(bodies, parts, body, a),
             &position(bodies, parts, body, b),
             &position(bodies, parts, body, cc),
         );
+        if surface.is_open() {
+            // Pushed back to the side of the shell the point started the step on (as a node
+            // of another body on an open shell, see `on_patch`).
+            let side = Real::from(geometry.point_side(body, o, c.node));
+            t.normal = t.normal.map(|n| n * side);
+            t.depth *= side;
+        }
         return Some(Touch {
             depth: t.depth,
             normal: t.normal,

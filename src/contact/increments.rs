@@ -181,13 +181,14 @@ impl ContactSolver {
         )];
     }
 
-    /// The problem of the current state with `set`, `forces` (N per body DOF) and the obstacles
-    /// at `offsets` (m), for `step`: the contact Newton's limits and friction's history.
+    /// The problem of the current state with `set`, `forces` (N per body DOF; following
+    /// pressures at pseudo-time `time`) and the obstacles at `offsets` (m), for `step`: the
+    /// contact Newton's limits and friction's history.
     fn problem<'a>(
         &'a self,
         bodies: &'a [Body],
         set: &'a ContactSet,
-        forces: &'a [Vec<Real>],
+        (forces, time): (&'a [Vec<Real>], (Real, usize)),
         offsets: &'a [Vector3<Real>],
         step: usize,
     ) -> Problem<'a> {
@@ -197,6 +198,7 @@ impl ContactSolver {
             geometry: &self.geometry,
             set,
             forces,
+            time,
             offsets,
             step,
             tolerance,
@@ -225,7 +227,7 @@ impl ContactSolver {
         let found = self.look(bodies, &self.active.clone(), &offsets);
         let history = self.friction.as_ref()?;
         let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
-        let problem = self.problem(bodies, &found, &forces, &offsets, step);
+        let problem = self.problem(bodies, &found, (&forces, (t, steps)), &offsets, step);
         let mut normals = self.normals.clone();
         let evaluated = problem.evaluate(&mut normals, &self.parts);
         // Per body: the mean direction its contacts press it along, and the largest μ among
@@ -286,7 +288,7 @@ impl ContactSolver {
         };
         let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
         let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
-        let problem = self.problem(bodies, &self.active, &forces, &offsets, step);
+        let problem = self.problem(bodies, &self.active, (&forces, (t, steps)), &offsets, step);
         let mut normals = self.normals.clone();
         let evaluated = problem.evaluate(&mut normals, &self.parts);
         let mut committed = HashMap::new();
@@ -376,7 +378,7 @@ impl ContactSolver {
             }
         }
         let current: Vec<Vec<Real>> = self.parts.iter().map(|p| p.u.clone()).collect();
-        let mut best = self.out_of_balance_norm(bodies, &forces, &offsets, step);
+        let mut best = self.out_of_balance_norm(bodies, (&forces, (t1, steps)), &offsets, step);
         let mut chosen = None;
         for points in 2..=n {
             let tail = &self.path[n - points..];
@@ -391,7 +393,7 @@ impl ContactSolver {
                         .sum();
                 }
             }
-            let r = self.out_of_balance_norm(bodies, &forces, &offsets, step);
+            let r = self.out_of_balance_norm(bodies, (&forces, (t1, steps)), &offsets, step);
             if r.is_finite() && r < best {
                 best = r;
                 chosen = Some(self.parts.iter().map(|p| p.u.clone()).collect::<Vec<_>>());
@@ -410,11 +412,11 @@ impl ContactSolver {
     fn out_of_balance_norm(
         &self,
         bodies: &[Body],
-        forces: &[Vec<Real>],
+        (forces, time): (&[Vec<Real>], (Real, usize)),
         offsets: &[Vector3<Real>],
         step: usize,
     ) -> Real {
-        let problem = self.problem(bodies, &self.active, forces, offsets, step);
+        let problem = self.problem(bodies, &self.active, (forces, time), offsets, step);
         let mut normals = self.normals.clone();
         let evaluated = problem.evaluate(&mut normals, &self.parts);
         let (r, _) = self

@@ -6,9 +6,10 @@ use crate::contact::detect::Geometry;
 use crate::contact::evaluate::{evaluate, Evaluation};
 use crate::contact::{ActiveContact, ContactError, ContactSet, FrictionHistory};
 use crate::linkage::dynamics::InertiaTerm;
-use crate::linkage::{Body, Convergence};
+use crate::linkage::{follower_forces, Body, Convergence};
 use crate::Real;
 use nalgebra::Vector3;
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 /// The stabilisation of a singular tangent, relative to its largest diagonal entry: small
@@ -31,8 +32,12 @@ pub(crate) struct Problem<'a> {
     pub(crate) geometry: &'a Geometry,
     /// The contacts held fixed.
     pub(crate) set: &'a ContactSet,
-    /// Applied force per body DOF of each body, N.
+    /// Applied force per body DOF of each body, N (nodal loads; a linear body's pressure is
+    /// among them, on its undeformed faces).
     pub(crate) forces: &'a [Vec<Real>],
+    /// The pseudo-time (step units) and steps at which the following pressures of bodies
+    /// under large displacements are evaluated, on their deformed faces ([`Problem::applied`]).
+    pub(crate) time: (Real, usize),
     /// Obstacle offsets along their travel, m.
     pub(crate) offsets: &'a [Vector3<Real>],
     /// The step (for messages).
@@ -52,6 +57,27 @@ pub(crate) struct Problem<'a> {
 }
 
 impl Problem<'_> {
+    /// The applied force per body DOF of body `b` at its displacement `u` (per body DOF, m),
+    /// N: its nodal loads plus its following pressures on the faces deformed by `u` at
+    /// [`Problem::time`] (`F + F_p(u)`, as a body's own Newton,
+    /// [`crate::linkage::follower_forces`]).
+    pub(crate) fn applied(&self, b: usize, u: &[Real]) -> Cow<'_, [Real]> {
+        let body = &self.bodies[b];
+        if body.pressures.is_empty() {
+            return Cow::Borrowed(&self.forces[b]);
+        }
+        let (t, steps) = self.time;
+        let mut follower = vec![0.0; u.len()];
+        follower_forces(body, u, t, steps, &mut follower);
+        Cow::Owned(
+            self.forces[b]
+                .iter()
+                .zip(&follower)
+                .map(|(f, p)| f + p)
+                .collect(),
+        )
+    }
+
     /// Every contact of the set evaluated at the bodies' current displacements.
     pub(crate) fn evaluate(
         &self,

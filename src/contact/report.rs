@@ -54,7 +54,7 @@ pub(crate) fn finish(
     evaluated: Evaluation,
     mut out: ContactStep,
 ) -> Result<ContactStep, ContactError> {
-    let (bodies, forces, step) = (p.bodies, p.forces, p.step);
+    let (bodies, step) = (p.bodies, p.step);
     let Evaluation { forces: all, list } = evaluated;
     // Per body, per node touched: (what it touches, deepest depth, force received).
     let mut touched: Vec<Vec<NodeContact>> = vec![Vec::new(); bodies.len()];
@@ -155,7 +155,7 @@ pub(crate) fn finish(
                 p,
                 (b, &parts[b]),
                 body,
-                &forces[b],
+                &p.applied(b, &parts[b].u),
                 fc,
                 contacts,
                 iterations,
@@ -174,7 +174,8 @@ pub(crate) fn finish(
 /// One body's part of the report: its totals per pair, its state and its contacts.
 type BodyReport = (Vec<(String, Vector3<Real>)>, StepState, Vec<NodeContact>);
 
-/// The report of one body (`part` of `body`, number `b`, applied `forces`, contact forces `fc` per DOF,
+/// The report of one body (`part` of `body`, number `b`, applied `forces` (following pressures
+/// included), contact forces `fc` per DOF,
 /// the nodes it touches with) after `iterations` Newton iterations.
 fn body_report(
     p: &Problem,

@@ -318,7 +318,7 @@ impl ContactSolver {
             }
             out.contact_iterations += 1;
             let (iterations, settled) =
-                self.newton(bodies, &set, (&forces, &offsets), step, inertia)?;
+                self.newton(bodies, &set, (&forces, &offsets), (t, steps), step, inertia)?;
             out.newton_iterations += iterations;
             out.stabilised |= !settled;
             let mut found = self.look(bodies, &set, &offsets);
@@ -412,6 +412,7 @@ impl ContactSolver {
             geometry: &self.geometry,
             set: &self.active,
             forces: &forces,
+            time: (t, steps),
             offsets: &offsets,
             step,
             tolerance,
@@ -447,8 +448,9 @@ impl ContactSolver {
         }
     }
 
-    /// Newton on all bodies with the contact set fixed: condensed on the candidates while every
-    /// body can be, else coupled. Returns the iterations and whether it converged; `false`
+    /// Newton on all bodies with the contact set fixed (loads `forces` and obstacles at
+    /// `offsets`, following pressures at pseudo-time `time`): condensed on the candidates while
+    /// every body can be, else coupled. Returns the iterations and whether it converged; `false`
     /// after one stabilised move (the tangent is singular with this set: a body held only by
     /// contact that has not reached its contacts yet), so that the contacts are looked for
     /// again.
@@ -457,6 +459,7 @@ impl ContactSolver {
         bodies: &[Body],
         set: &ContactSet,
         (forces, offsets): (&[Vec<Real>], &[Vector3<Real>]),
+        time: (Real, usize),
         step: usize,
         inertia: Option<&[InertiaTerm]>,
     ) -> Result<(usize, bool), ContactError> {
@@ -466,6 +469,7 @@ impl ContactSolver {
             geometry: &self.geometry,
             set,
             forces,
+            time,
             offsets,
             step,
             tolerance,

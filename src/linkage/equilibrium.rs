@@ -152,12 +152,6 @@ pub enum SolveError {
         /// What to change instead.
         remedy: String,
     },
-    /// A pressure that follows the deformation, in a scene with contact.
-    #[error("body '{body}': a pressure on a body under large displacements follows the deformed faces, which is not supported yet in a scene with contact (obstacles or [contact]): make the body linear (kinematics = \"linear\": the pressure then acts on the undeformed faces), or solve it without contact")]
-    PressureUnsupported {
-        /// Body name.
-        body: String,
-    },
     /// The solve returned a result that does not satisfy equilibrium.
     #[error("body '{body}': the solution misses equilibrium by {residual:e} (relative): the stiffness matrix is too ill-conditioned (members of very different stiffness, or nearly collinear members); check the materials and the geometry")]
     Inaccurate {

@@ -22,7 +22,9 @@ pub use self::member_stiffness::{
     axial_stiffness, linear_member_block, member_axial_stiffness, member_block,
     member_stiffness_matrix, member_stiffnesses,
 };
-pub(crate) use self::newton::{lagrange_weights, IncrementSize};
+pub(crate) use self::newton::{
+    add_follower_load_stiffness, follower_forces, lagrange_weights, pair_members, IncrementSize,
+};
 pub use self::newton::{NewtonEquilibrium, SavedNewton};
 pub use self::pressure::{
     chosen_patches, face_forces, load_stiffness_blocks, load_stiffness_parts, pressure_loads,

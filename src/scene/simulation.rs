@@ -73,14 +73,6 @@ impl<'w> Simulation<'w> {
                     ));
                 }
             }
-            if let Some(body) = world.bodies.iter().find(|b| !b.pressures.is_empty()) {
-                return Err(RunError::Solve {
-                    scene: world.source.clone(),
-                    source: SolveError::PressureUnsupported {
-                        body: body.name.clone(),
-                    },
-                });
-            }
         }
         let solver = if world.has_contact() {
             let contact =
@@ -530,13 +522,9 @@ impl<'w> Simulation<'w> {
 }
 
 /// Per body of a world solved body by body, the watch for its self-contact: breaking bodies
-/// with self-contact on (see [`self_contact_on`]), when the world can go on with the contact
-/// solver (no pressure loads: the contact solver does not take them) and its surface is one the
-/// contact detection takes.
+/// with self-contact on (see [`self_contact_on`]) whose surface is one the contact detection
+/// takes (pressures too: the contact solver takes them, following ones included).
 fn self_watches(world: &World) -> Vec<Option<SelfContactWatch>> {
-    if world.bodies.iter().any(|b| !b.pressures.is_empty()) {
-        return Vec::new();
-    }
     world
         .bodies
         .iter()

@@ -140,6 +140,75 @@ pub(crate) fn follower_forces(body: &Body, u: &[Real], t: Real, steps: usize, ou
     }
 }
 
+/// A node pair joined by a member and the member: `((lower, higher), member)`.
+pub(crate) type PairMember = ((usize, usize), usize);
+
+/// Per node pair joined by a member of `body`, sorted: `((lower, higher), member)`, to place
+/// the following pressures' load stiffness ([`add_follower_load_stiffness`]).
+pub(crate) fn pair_members(body: &Body) -> Vec<PairMember> {
+    let mut pairs: Vec<PairMember> = body
+        .members
+        .iter()
+        .enumerate()
+        .map(|(m, member)| {
+            let [a, b] = member.nodes;
+            ((a.min(b), a.max(b)), m)
+        })
+        .collect();
+    pairs.sort_unstable();
+    pairs
+}
+
+/// Add to the tangent `values` (N/m, in the pattern of `assembly` over `dofs`; `pairs` from
+/// [`pair_members`]) the symmetric part of `body`'s following pressures' load stiffness at
+/// displacement `u` (per body DOF, m) and pseudo-time `t` of `steps` (see
+/// [`crate::linkage::symmetric_load_stiffness_blocks`]) where it is the whole of it on the
+/// free DOFs (a closed surface under one pressure, or a rim that moves only in supported
+/// directions): Newton is then exact and quadratic. Elsewhere the skew part is not small, the
+/// symmetric part alone can slow Newton down, and the tangent leaves the load stiffness out
+/// (Newton converges linearly). Shared by a body's Newton and the contact solver's.
+pub(crate) fn add_follower_load_stiffness(
+    body: &Body,
+    (dofs, assembly, pairs): (&DofMap, &StiffnessAssembly, &[PairMember]),
+    u: &[Real],
+    (t, steps): (Real, usize),
+    values: &mut [Real],
+) {
+    let d = body.dimension.dofs_per_node();
+    let slots = &dofs.slots;
+    let (skew, symmetric) = crate::linkage::load_stiffness_parts(
+        body.pressures
+            .iter()
+            .map(|p| (&p.faces, p.pressure * factor_at(&p.schedule, t, steps))),
+        |n| body.nodes[n] + node_vector(u, d, n),
+        |n, k| k < d && matches!(slots[n * d + k], crate::linkage::DofSlot::Free(_)),
+    );
+    if skew > SYMMETRIC_LOAD_STIFFNESS * symmetric {
+        return;
+    }
+    for p in &body.pressures {
+        let factor = factor_at(&p.schedule, t, steps);
+        if factor == 0.0 {
+            continue;
+        }
+        crate::linkage::symmetric_load_stiffness_blocks(
+            &p.faces,
+            p.pressure * factor,
+            |n| body.nodes[n] + node_vector(u, d, n),
+            |i, j, block| {
+                // Each unordered pair comes as (i, j) and (j, i): keep the one with the
+                // higher node as rows, which is what the lower triangle stores.
+                if i <= j {
+                    return;
+                }
+                if let Ok(k) = pairs.binary_search_by(|probe| probe.0.cmp(&(j, i))) {
+                    assembly.add_pair_block(pairs[k].1, &block, values);
+                }
+            },
+        );
+    }
+}
+
 /// The skew part of the pressures' load stiffness on the free DOFs, relative to its symmetric
 /// part, below which the symmetric part is taken as the whole (round-off of a closed surface).
 const SYMMETRIC_LOAD_STIFFNESS: Real = 1e-8;
@@ -203,16 +272,7 @@ impl NewtonEquilibrium {
             pair_members: Vec::new(),
         };
         if !body.pressures.is_empty() {
-            eq.pair_members = body
-                .members
-                .iter()
-                .enumerate()
-                .map(|(m, member)| {
-                    let [a, b] = member.nodes;
-                    ((a.min(b), a.max(b)), m)
-                })
-                .collect();
-            eq.pair_members.sort_unstable();
+            eq.pair_members = pair_members(body);
         }
         eq.fill_tangent(body);
         eq.times.assembly += t.elapsed().as_secs_f64();
@@ -434,54 +494,16 @@ impl NewtonEquilibrium {
         }
     }
 
-    /// Add the symmetric part of the following pressures' load stiffness at the current
-    /// displacement (see [`crate::linkage::symmetric_load_stiffness_blocks`]) where it is the
-    /// whole of it on the free DOFs (a closed surface under one pressure, or a rim that moves
-    /// only in supported directions): Newton is then exact and quadratic. Elsewhere the skew
-    /// part is not small, the symmetric part alone can slow Newton down, and the tangent
-    /// leaves the load stiffness out (Newton converges linearly).
+    /// Add the following pressures' load stiffness at the current displacement where it is
+    /// symmetric (see [`add_follower_load_stiffness`]).
     fn add_load_stiffness(&mut self, body: &Body) {
-        let d = body.dimension.dofs_per_node();
-        let (t, steps) = self.follower_time;
-        let u = &self.u;
-        let slots = &self.dofs.slots;
-        let (skew, symmetric) = crate::linkage::load_stiffness_parts(
-            body.pressures
-                .iter()
-                .map(|p| (&p.faces, p.pressure * factor_at(&p.schedule, t, steps))),
-            |n| body.nodes[n] + node_vector(u, d, n),
-            |n, k| k < d && matches!(slots[n * d + k], crate::linkage::DofSlot::Free(_)),
+        add_follower_load_stiffness(
+            body,
+            (&self.dofs, &self.assembly, &self.pair_members),
+            &self.u,
+            self.follower_time,
+            &mut self.values,
         );
-        if skew > SYMMETRIC_LOAD_STIFFNESS * symmetric {
-            return;
-        }
-        for p in &body.pressures {
-            let factor = factor_at(&p.schedule, t, steps);
-            if factor == 0.0 {
-                continue;
-            }
-            let (u, pairs, assembly, values) = (
-                &self.u,
-                &self.pair_members,
-                &self.assembly,
-                &mut self.values,
-            );
-            crate::linkage::symmetric_load_stiffness_blocks(
-                &p.faces,
-                p.pressure * factor,
-                |n| body.nodes[n] + node_vector(u, d, n),
-                |i, j, block| {
-                    // Each unordered pair comes as (i, j) and (j, i): keep the one with the
-                    // higher node as rows, which is what the lower triangle stores.
-                    if i <= j {
-                        return;
-                    }
-                    if let Ok(k) = pairs.binary_search_by(|probe| probe.0.cmp(&(j, i))) {
-                        assembly.add_pair_block(pairs[k].1, &block, values);
-                    }
-                },
-            );
-        }
     }
 
     /// The applied force per body DOF, N: the nodal `forces` plus the following pressures at
