@@ -22,8 +22,8 @@ pub use self::member_stiffness::{
     axial_stiffness, linear_member_block, member_axial_stiffness, member_block,
     member_stiffness_matrix, member_stiffnesses,
 };
+pub use self::newton::{add_stop_forces, stop_forces, NewtonEquilibrium, SavedNewton, Stop};
 pub(crate) use self::newton::{lagrange_weights, IncrementSize};
-pub use self::newton::{NewtonEquilibrium, SavedNewton};
 pub use self::pressure::{
     chosen_patches, face_forces, load_stiffness_blocks, load_stiffness_parts, pressure_loads,
     pressure_loads_on, symmetric_load_stiffness_blocks, Pressure, PressureFaces,
