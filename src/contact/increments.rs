@@ -3,11 +3,14 @@
 //! A step goes from the last converged pseudo-time to the step's, with the loads, prescribed
 //! support displacements and obstacle offsets interpolated between steps. An increment that
 //! fails (Newton not converged, a state not finite, a tangent that cannot be factored) is
-//! undone: the displacements, the contact set and the normals go back to the last converged
-//! state, the condensed path (which solves whole steps only) gives way to the coupled one, and
-//! the increment is halved ([`IncrementSize`], as for a body). Only the converged end of the
-//! step is reported.
+//! undone: the displacements, the contact set, the normals and the condensed path's contact
+//! forces go back to the last converged state, and the increment is halved
+//! ([`IncrementSize`], as for a body). The condensed path cuts as the coupled one does and
+//! stays condensed (its loads are interpolated within a step as the coupled path's are); it
+//! gives way to the coupled solve only where a body cannot be condensed on the nodes its
+//! contacts reach. Only the converged end of the step is reported.
 
+use crate::contact::condensed::CondensedState;
 use crate::contact::evaluate::friction_key;
 use crate::contact::problem::{newton_limits, Problem, PATH_POINTS};
 use crate::contact::report::ContactStep;
@@ -25,6 +28,8 @@ pub(crate) struct Converged {
     u: Vec<Vec<Real>>,
     active: ContactSet,
     normals: HashMap<ActiveContact, Vector3<Real>>,
+    /// The condensed path's state (`None` on the coupled path).
+    condensed: Option<CondensedState>,
 }
 
 impl ContactSolver {
@@ -69,7 +74,7 @@ impl ContactSolver {
             }
         }
         if let Some(c) = self.condensed.as_mut() {
-            c.start_step(step, steps, restart);
+            c.start_step(restart);
         }
         let start = if restart { 0 } else { self.step };
         self.step = step;
@@ -80,14 +85,18 @@ impl ContactSolver {
         let mut size = IncrementSize::default();
         let mut out = ContactStep::default();
         loop {
-            // The condensed path solves whole steps (its loads are per step); the coupled one
-            // crosses at most a step per increment.
-            let t1 = if self.condensed.is_some() || end - t <= size.fraction() * (1.0 + 1e-12) {
+            // An increment crosses at most a step (the condensed path, uncut, the whole way to
+            // the step asked for, as it always has).
+            let whole = self.condensed.is_some() && size.depth == 0;
+            let t1 = if whole || end - t <= size.fraction() * (1.0 + 1e-12) {
                 end
             } else {
                 t + size.fraction()
             };
             let saved = self.converged_state();
+            if let Some(c) = self.condensed.as_mut() {
+                c.aim(t1, steps);
+            }
             // Every increment starts from the last converged state: the shells' sides too.
             self.geometry
                 .record_sides(bodies, &self.parts, &self.active);
@@ -102,7 +111,7 @@ impl ContactSolver {
                     out.stabilised |= done.stabilised;
                     out.warnings.extend(done.warnings);
                     if let Some(c) = self.condensed.as_mut() {
-                        c.solved(step);
+                        c.solved(t1);
                     }
                     if self.path.len() == PATH_POINTS {
                         self.path.remove(0);
@@ -123,14 +132,13 @@ impl ContactSolver {
                     // contacts beyond μ N: say so by name (judged where the attempt ended,
                     // which has found the contacts the loads press it on).
                     let sliding = self.sliding(bodies, obstacles, step, steps);
-                    self.restore(saved);
+                    self.restore_increment(saved)?;
                     if let Some(sliding) = sliding {
                         return Err(sliding);
                     }
                     if !retried(&e) {
                         return Err(e);
                     }
-                    self.leave_condensed()?;
                     if !size.failed(max_cuts) {
                         return Err(cut_to(e, step, &size));
                     }
@@ -139,8 +147,7 @@ impl ContactSolver {
                     if let ContactError::NotConverged { history, .. } = &e {
                         out.newton_iterations += history.len().saturating_sub(1);
                     }
-                    self.restore(saved);
-                    self.leave_condensed()?;
+                    self.restore_increment(saved)?;
                     if !size.failed(max_cuts) {
                         return Err(cut_to(e, step, &size));
                     }
@@ -320,11 +327,28 @@ impl ContactSolver {
             u: self.parts.iter().map(|p| p.u.clone()).collect(),
             active: self.active.clone(),
             normals: self.normals.clone(),
+            condensed: self.condensed.as_ref().map(|c| c.saved()),
         }
     }
 
-    /// Undo a failed increment.
+    /// Undo a failed increment (the condensed path's contact forces too, where they still
+    /// fit its candidates).
     pub(crate) fn restore(&mut self, saved: Converged) {
+        self.restore_keeping(saved);
+    }
+
+    /// [`ContactSolver::restore`], then leave the condensed path unless it was restored: the
+    /// attempt left it, or a body's candidates grew so that the saved forces no longer fit
+    /// (the coupled solve goes on from the restored displacements).
+    fn restore_increment(&mut self, saved: Converged) -> Result<(), ContactError> {
+        if !self.restore_keeping(saved) {
+            self.leave_condensed()?;
+        }
+        Ok(())
+    }
+
+    /// Undo a failed increment; whether the condensed path's state was restored.
+    fn restore_keeping(&mut self, saved: Converged) -> bool {
         for (p, u) in self.parts.iter_mut().zip(saved.u) {
             p.u = u;
         }
@@ -332,6 +356,10 @@ impl ContactSolver {
         self.normals = saved.normals;
         // Crossings found in the failed increment belong to a state that is gone.
         self.geometry.forget_crossings_found();
+        match (self.condensed.as_mut(), saved.condensed) {
+            (Some(c), Some(state)) => c.restore(state),
+            _ => false,
+        }
     }
 
     /// Leave the condensed path (if on it) for the coupled solve of all bodies.

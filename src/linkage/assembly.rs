@@ -222,6 +222,16 @@ impl StiffnessAssembly {
         }
     }
 
+    /// Add the symmetric 3×3 `block` (in 2D its upper-left 2×2) to `node`'s own block of
+    /// `K_ff` in `values` (a penalty spring holding the node).
+    pub fn add_node_block(&self, node: usize, block: &Matrix3<Real>, values: &mut [Real]) {
+        for (k, &place) in self.diagonal[node].iter().enumerate() {
+            if place != NOT_FREE {
+                values[place as usize] += block[(k / 3, k % 3)];
+            }
+        }
+    }
+
     /// The place in the value array of `K_ff`'s diagonal entry of `node`'s direction `dir`,
     /// if that DOF is free (to hold a DOF that lost every member).
     pub fn diagonal_place(&self, node: usize, dir: usize) -> Option<usize> {

@@ -25,7 +25,7 @@ pub use self::member_stiffness::{
 pub(crate) use self::newton::{
     add_follower_load_stiffness, follower_forces, lagrange_weights, pair_members, IncrementSize,
 };
-pub use self::newton::{NewtonEquilibrium, SavedNewton};
+pub use self::newton::{add_stop_forces, stop_forces, NewtonEquilibrium, SavedNewton, Stop};
 pub use self::pressure::{
     chosen_patches, face_forces, load_stiffness_blocks, load_stiffness_parts, pressure_loads,
     pressure_loads_on, symmetric_load_stiffness_blocks, Pressure, PressureFaces,

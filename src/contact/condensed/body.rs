@@ -1,7 +1,7 @@
 //! A linear body factored once per run and condensed on its contact candidates: compliance, rigid motions and the load patterns.
 
 use crate::linalg::cholesky::{CholeskyError, SparseCholesky};
-use crate::linkage::body_state::tangent_times;
+use crate::linkage::body_state::{factor_at, tangent_times};
 use crate::linkage::mechanism::diagnose_mechanism;
 use crate::linkage::rigid_modes::{free_rigid_modes, pinned_dofs_avoiding};
 use crate::linkage::Mechanism;
@@ -290,12 +290,14 @@ impl CondensedBody {
         self.cand.len()
     }
 
-    /// The load of `step` of `steps` per free DOF (N) and `K⁻¹` of it at the candidates (m).
-    pub fn step_load(&self, step: usize, steps: usize) -> (Vec<Real>, Vec<Real>) {
+    /// The load at pseudo-time `t` of `steps` (step units; between steps each schedule's
+    /// factor is interpolated, see [`factor_at`]) per free DOF (N) and `K⁻¹` of it at the
+    /// candidates (m).
+    pub fn load_at(&self, t: Real, steps: usize) -> (Vec<Real>, Vec<Real>) {
         let mut load = vec![0.0; self.slot.len()];
         let mut base = vec![0.0; self.cand.len()];
         for p in &self.patterns {
-            let f = p.schedule.factor(step, steps);
+            let f = factor_at(&p.schedule, t, steps);
             load.iter_mut().zip(&p.load).for_each(|(a, b)| *a += f * b);
             base.iter_mut().zip(&p.base).for_each(|(a, b)| *a += f * b);
         }

@@ -4,7 +4,7 @@ pub(crate) use self::body::{CondenseFailure, CondensedBody, NOT_CANDIDATE};
 pub(crate) use self::jacobian::{
     approximate_from, exact_for, ContactJacobian, ContactRow, Correction, FrictionRow,
 };
-pub(crate) use self::solver::CondensedSolver;
+pub(crate) use self::solver::{CondensedSolver, CondensedState};
 
 mod anderson;
 mod body;

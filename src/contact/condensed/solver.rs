@@ -36,11 +36,12 @@ struct Condensation {
     alpha_expanded: Vec<Real>,
     /// Load plus contact forces per free DOF at the last full solve, N.
     rhs_expanded: Vec<Real>,
-    /// The step being solved and the number of steps (the load of a body condensed again).
-    step: (usize, usize),
-    /// The last two solved steps: (step, f̂, α), oldest first (the next step starts from their
-    /// extrapolation).
-    history: Vec<(usize, Vec<Real>, Vec<Real>)>,
+    /// The pseudo-time aimed at (step units) and the number of steps (the load of a body
+    /// condensed again).
+    step: (Real, usize),
+    /// The last two solved increments: (pseudo-time, f̂, α), oldest first (the next increment
+    /// starts from their extrapolation).
+    history: Vec<(Real, Vec<Real>, Vec<Real>)>,
     /// Whether the bodies' displacements are those of the last full solve (no placement since).
     fresh: bool,
 }
@@ -57,11 +58,28 @@ impl Condensation {
             alpha_expanded: vec![0.0; r],
             rhs_expanded: vec![0.0; body.slot.len()],
             history: Vec::new(),
-            step: (0, 1),
+            step: (0.0, 1),
             fresh: false,
             body,
         }
     }
+}
+
+/// One body's condensed state at the last converged increment (see [`CondensedState`]).
+struct SavedCondensation {
+    fhat: Vec<Real>,
+    alpha: Vec<Real>,
+    expanded: Vec<Real>,
+    alpha_expanded: Vec<Real>,
+    rhs_expanded: Vec<Real>,
+    /// Candidate DOFs then (a body condensed again since cannot take the saved forces).
+    candidates: usize,
+}
+
+/// The condensed state a failed increment is undone to: per body the contact forces and
+/// rigid amplitudes assumed, and the last full solve.
+pub(crate) struct CondensedState {
+    bodies: Vec<SavedCondensation>,
 }
 
 /// The residuals of the condensed problem at one placement.
@@ -180,45 +198,105 @@ impl CondensedSolver {
         Some(c.body.nodes.iter().filter(|&&m| m).count())
     }
 
-    /// Start `step` of `steps`: each body's load and base displacement (`restart`: from rest).
-    pub(crate) fn start_step(&mut self, step: usize, steps: usize, restart: bool) {
+    /// Start a step (`restart`: from rest, forgetting the solved increments).
+    pub(crate) fn start_step(&mut self, restart: bool) {
+        if !restart {
+            return;
+        }
         for c in self.bodies.iter_mut() {
-            if restart {
-                c.fhat.iter_mut().for_each(|v| *v = 0.0);
-                c.alpha.iter_mut().for_each(|v| *v = 0.0);
-                c.alpha_expanded.iter_mut().for_each(|v| *v = 0.0);
-                c.expanded.iter_mut().for_each(|v| *v = 0.0);
-                c.rhs_expanded.iter_mut().for_each(|v| *v = 0.0);
-                c.history.clear();
-            }
-            // Start from the straight line through the last two solved steps (exact for loads
-            // that grow in proportion while the contacts stay): Newton then only corrects.
-            if let [(s0, f0, a0), (s1, f1, a1)] = &c.history[..] {
-                if *s1 + 1 == step && *s0 + 1 == *s1 && f1.len() == c.fhat.len() {
-                    for (v, (x1, x0)) in c.fhat.iter_mut().zip(f1.iter().zip(f0)) {
-                        *v = 2.0 * x1 - x0;
-                    }
-                    for (v, (x1, x0)) in c.alpha.iter_mut().zip(a1.iter().zip(a0)) {
-                        *v = 2.0 * x1 - x0;
-                    }
-                }
-            }
-            let (load, base) = c.body.step_load(step, steps);
-            c.load = load;
-            c.base = base;
-            c.fresh = false;
-            c.step = (step, steps);
+            c.fhat.iter_mut().for_each(|v| *v = 0.0);
+            c.alpha.iter_mut().for_each(|v| *v = 0.0);
+            c.alpha_expanded.iter_mut().for_each(|v| *v = 0.0);
+            c.expanded.iter_mut().for_each(|v| *v = 0.0);
+            c.rhs_expanded.iter_mut().for_each(|v| *v = 0.0);
+            c.history.clear();
         }
     }
 
-    /// Remember the solved state of `step` for the next step's start.
-    pub(crate) fn solved(&mut self, step: usize) {
+    /// Aim the next increment at pseudo-time `t` of `steps` (step units, fractional within a
+    /// cut step): each body's load and base displacement there. The contact forces and rigid
+    /// amplitudes start from the straight line through the last two solved increments when
+    /// `t` lies no further beyond the newer than the two lie apart (exact for loads that grow
+    /// in proportion while the contacts stay): Newton then only corrects.
+    pub(crate) fn aim(&mut self, t: Real, steps: usize) {
+        for c in self.bodies.iter_mut() {
+            if let [(t0, f0, a0), (t1, f1, a1)] = &c.history[..] {
+                let (t0, t1) = (*t0, *t1);
+                if t0 < t1
+                    && t > t1
+                    && t - t1 <= (t1 - t0) * (1.0 + 1e-12)
+                    && f1.len() == c.fhat.len()
+                {
+                    // Lagrange weights of the two points at t (2 and -1 for whole steps).
+                    let w0 = (t - t1) / (t0 - t1);
+                    let w1 = (t - t0) / (t1 - t0);
+                    for (v, (x1, x0)) in c.fhat.iter_mut().zip(f1.iter().zip(f0)) {
+                        *v = w1 * x1 + w0 * x0;
+                    }
+                    for (v, (x1, x0)) in c.alpha.iter_mut().zip(a1.iter().zip(a0)) {
+                        *v = w1 * x1 + w0 * x0;
+                    }
+                }
+            }
+            let (load, base) = c.body.load_at(t, steps);
+            c.load = load;
+            c.base = base;
+            c.fresh = false;
+            c.step = (t, steps);
+        }
+    }
+
+    /// Remember the solved state at pseudo-time `t` for the next increment's start.
+    pub(crate) fn solved(&mut self, t: Real) {
         for c in self.bodies.iter_mut() {
             if c.history.len() == 2 {
                 c.history.remove(0);
             }
-            c.history.push((step, c.fhat.clone(), c.alpha.clone()));
+            c.history.push((t, c.fhat.clone(), c.alpha.clone()));
         }
+    }
+
+    /// The condensed state of the last converged increment, to undo a failed one with
+    /// [`CondensedSolver::restore`].
+    pub(crate) fn saved(&self) -> CondensedState {
+        CondensedState {
+            bodies: self
+                .bodies
+                .iter()
+                .map(|c| SavedCondensation {
+                    fhat: c.fhat.clone(),
+                    alpha: c.alpha.clone(),
+                    expanded: c.expanded.clone(),
+                    alpha_expanded: c.alpha_expanded.clone(),
+                    rhs_expanded: c.rhs_expanded.clone(),
+                    candidates: c.body.len(),
+                })
+                .collect(),
+        }
+    }
+
+    /// Undo a failed increment: back to `saved` (the kept Jacobian, made at the failed
+    /// attempt's placements, is dropped). `false` when a body's candidates grew since (its
+    /// saved forces no longer fit): the caller then leaves the condensed path.
+    pub(crate) fn restore(&mut self, saved: CondensedState) -> bool {
+        if saved
+            .bodies
+            .iter()
+            .zip(&self.bodies)
+            .any(|(s, c)| s.candidates != c.body.len())
+        {
+            return false;
+        }
+        for (c, s) in self.bodies.iter_mut().zip(saved.bodies) {
+            c.fhat = s.fhat;
+            c.alpha = s.alpha;
+            c.expanded = s.expanded;
+            c.alpha_expanded = s.alpha_expanded;
+            c.rhs_expanded = s.rhs_expanded;
+            c.fresh = false;
+        }
+        self.jacobian = None;
+        true
     }
 
     /// Write the condensed state into the bodies' displacements: exact at the candidates,
@@ -594,7 +672,7 @@ impl CondensedSolver {
             c.history.clear();
             c.fresh = false;
             c.body = grown;
-            let (load, base) = c.body.step_load(c.step.0, c.step.1);
+            let (load, base) = c.body.load_at(c.step.0, c.step.1);
             c.load = load;
             c.base = base;
         }

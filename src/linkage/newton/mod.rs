@@ -27,8 +27,10 @@ use std::time::Instant;
 mod arc_length;
 mod load_control;
 mod saved;
+mod stops;
 
 pub use self::saved::SavedNewton;
+pub use self::stops::{add_stop_forces, stop_forces, Stop};
 
 /// The reason of an increment stopped by [`crate::linkage::Interrupt`] (never retried: the
 /// retry returns [`SolveError::Interrupted`]).
@@ -115,6 +117,8 @@ pub struct NewtonEquilibrium {
     /// Per node pair joined by a member, sorted: `((lower, higher), member)`, to place the
     /// pressures' load stiffness (empty without pressures).
     pair_members: Vec<((usize, usize), usize)>,
+    /// Fixed planes the body presses against (see [`Stop`]; empty without).
+    stops: Vec<Stop>,
 }
 
 /// The force per body DOF (N) of `body`'s following pressures at displacement `u` (per body
@@ -270,6 +274,7 @@ impl NewtonEquilibrium {
             follower: vec![0.0; nd],
             follower_time: (0.0, 1),
             pair_members: Vec::new(),
+            stops: Vec::new(),
         };
         if !body.pressures.is_empty() {
             eq.pair_members = pair_members(body);
@@ -317,6 +322,22 @@ impl NewtonEquilibrium {
             eq.factor_entries = eq.solver.as_ref().map_or(0, |s| s.factor_entries());
         }
         Ok(eq)
+    }
+
+    /// Hold the body against `stops` from now on: their penalty forces join its residual and
+    /// their stiffness its tangent (see [`Stop`]).
+    pub fn set_stops(&mut self, stops: Vec<Stop>) {
+        self.stops = stops;
+    }
+
+    /// The fixed planes the body presses against.
+    pub fn stops(&self) -> &[Stop] {
+        &self.stops
+    }
+
+    /// The current displacement per body DOF, m (of the last step solved).
+    pub fn displacement(&self) -> &[Real] {
+        &self.u
     }
 
     /// Conjugate-gradient iterations so far (0 with the direct solver).
@@ -459,6 +480,13 @@ impl NewtonEquilibrium {
         }
         let mut internal = vec![0.0; self.u.len()];
         internal_forces(body, &self.u, &mut internal);
+        if !self.stops.is_empty() {
+            // The stops' forces balance the members as the supports' do: taken off the
+            // internal forces, the out-of-balance is `F + F_stop − f_int`.
+            let mut pushed = vec![0.0; self.u.len()];
+            add_stop_forces(body, &self.stops, &self.u, &mut pushed);
+            internal.iter_mut().zip(&pushed).for_each(|(f, p)| *f -= p);
+        }
         let members = (0..body.members.len()).map(|m| {
             let r = member_response_at(body, &self.u, m);
             (r.strain, r.force)
@@ -491,6 +519,9 @@ impl NewtonEquilibrium {
         fill_tangent(body, &self.assembly, &self.u, &mut self.values);
         if body.newton.load_stiffness {
             self.add_load_stiffness(body);
+        }
+        if !self.stops.is_empty() {
+            stops::add_stop_stiffness(body, &self.stops, &self.u, &self.assembly, &mut self.values);
         }
     }
 
@@ -571,6 +602,12 @@ impl NewtonEquilibrium {
         if !body.pressures.is_empty() {
             let (t1, steps) = self.follower_time;
             follower_forces(body, &self.u, t1, steps, &mut self.follower);
+        }
+        if !self.stops.is_empty() {
+            // The stops push as the supports hold: off the internal forces.
+            let mut pushed = vec![0.0; internal.len()];
+            add_stop_forces(body, &self.stops, &self.u, &mut pushed);
+            internal.iter_mut().zip(&pushed).for_each(|(f, p)| *f -= p);
         }
         self.times.assembly += t.elapsed().as_secs_f64();
         self.dofs
