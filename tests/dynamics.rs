@@ -590,3 +590,32 @@ fn a_dynamic_run_plots_its_energies_and_writes_times_and_batch_columns() {
         "{ke}"
     );
 }
+
+/// A large-displacement body's pressure follows its deformed faces, which the time step's
+/// residual does not take yet: a dynamic scene with one is refused naming the body and what to
+/// do (before, the pressure was left out in silence and the body fell as if unloaded), and no
+/// results are written.
+#[test]
+fn a_following_pressure_in_a_dynamic_scene_is_refused_not_left_out() {
+    let scene = FALLING.replace("INTEGRATOR", "energy_momentum").replace(
+        "velocity = [0.5, 0.0]\n",
+        "velocity = [0.5, 0.0]\nkinematics = \"large\"\n\n[[bodies.pressures]]\non_line = { point = [0.0, 0.1], direction = [1.0, 0.0] }\npressure = 100.0\n",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let run = run_scene(dir.path(), &scene);
+    let msg = text(&run);
+    assert!(!run.status.success(), "{msg}");
+    assert!(
+        msg.contains("body 'block'")
+            && msg.contains("follows the deformed faces")
+            && msg.contains("kinematics = \"small\""),
+        "{msg}"
+    );
+    assert!(!msg.contains("panicked"), "{msg}");
+    assert!(!dir.path().join("out/falling/summary.json").exists());
+    // The same pressure on the small-displacement body acts on the undeformed faces: it runs.
+    let small = scene.replace("kinematics = \"large\"\n", "");
+    let dir = tempfile::tempdir().unwrap();
+    let run = run_scene(dir.path(), &small);
+    assert!(run.status.success(), "{}", text(&run));
+}

@@ -152,6 +152,13 @@ pub enum SolveError {
         /// What to change instead.
         remedy: String,
     },
+    /// A large-displacement body's following pressure in a dynamic scene: a time step does not
+    /// take a load that follows the deformed faces yet (it would be silently left out).
+    #[error("body '{body}': its pressure follows the deformed faces (kinematics = \"large\"), which a time step does not take yet ([dynamics]): use kinematics = \"small\" for this body (the pressure then acts on the undeformed faces), or remove [dynamics]")]
+    FollowingPressureInTime {
+        /// Body name.
+        body: String,
+    },
     /// The solve returned a result that does not satisfy equilibrium.
     #[error("body '{body}': the solution misses equilibrium by {residual:e} (relative): the stiffness matrix is too ill-conditioned (members of very different stiffness, or nearly collinear members); check the materials and the geometry")]
     Inaccurate {

@@ -96,6 +96,16 @@ impl<'w> DynamicSimulation<'w> {
             });
         };
         let integrator = settings.integrator.integrator();
+        // A large body's following pressure is not in the time step's residual: refused,
+        // never left out in silence.
+        if let Some(body) = world.bodies.iter().find(|b| !b.pressures.is_empty()) {
+            return Err(RunError::Solve {
+                scene: world.source.clone(),
+                source: SolveError::FollowingPressureInTime {
+                    body: body.name.clone(),
+                },
+            });
+        }
         let fracture = BreakingBodies::new(&world.bodies).map_err(|source| RunError::Solve {
             scene: world.source.clone(),
             source,
