@@ -429,3 +429,58 @@ schedule = [1.0, -1.0, -2.0]
         }
     }
 }
+
+/// Friction with a pressure (the pair F×P of *Features together*): the plate of
+/// [`a_plate_pressed_onto_the_floor_by_its_pressure_rests_on_the_pressure_resultant`], large
+/// displacements (the pressure following the deformed edge), on a floor with μ = 0.5. Pressed,
+/// the lattice spreads sideways away from its held left edge and the floor's friction holds its
+/// bottom back: the contacts carry a sideways force (at least 1 % of the resultant; exactly
+/// none without friction) that the held edge's reactions balance (1e-8), every contact stays in
+/// Coulomb's cone (|f_T| ≤ μ f_N, 1e-9), and vertically the floor still carries the following
+/// pressure's resultant (1e-8), as without friction.
+#[test]
+fn a_following_pressure_presses_a_plate_onto_a_floor_whose_friction_holds_its_spread() {
+    let mut sideways = Vec::new();
+    for mu in [0.0, 0.5] {
+        let dir = tempfile::tempdir().unwrap();
+        let friction = format!("[contact]\nfriction = {mu}\n");
+        let (summary, out) = run_scene(
+            dir.path(),
+            "rubs",
+            &format!(
+                "{}{friction}",
+                plate("large", 500.0, 2, SIDEWAYS, &floor(0.0))
+            ),
+        );
+        assert!(summary.failure.is_none());
+        let step = step_file(&out, "plate", 2);
+        let (l, r, c) = (
+            total(&step, "loads"),
+            total(&step, "reactions"),
+            total(&step, "contacts"),
+        );
+        let size = l[0].hypot(l[1]);
+        assert!(size > 199.0, "{l:?}");
+        for k in 0..2 {
+            assert!(
+                (l[k] + r[k] + c[k]).abs() <= 1e-8 * size,
+                "μ = {mu}: {l:?} {r:?} {c:?}"
+            );
+        }
+        assert!(r[1].abs() <= 1e-10 * size, "μ = {mu}: {r:?}");
+        assert!((c[1] + l[1]).abs() <= 1e-8 * size, "μ = {mu}: {c:?} {l:?}");
+        for e in step["bodies"][0]["contacts"].as_array().unwrap() {
+            let t = vector(&e["tangential_force"]);
+            let n = e["normal_force"].as_f64().unwrap();
+            assert!(
+                t[0].hypot(t[1]) <= mu * n * (1.0 + 1e-9) + 1e-12 * size,
+                "μ = {mu}: {e}"
+            );
+        }
+        eprintln!("μ = {mu}: contacts {c:?} N, reactions {r:?} N, loads {l:?} N");
+        sideways.push(c[0].abs() / size);
+        assert!(summary.steps[2].residual <= 1e-9, "{:?}", summary.steps[2]);
+    }
+    assert!(sideways[0] <= 1e-10, "frictionless: {sideways:?}");
+    assert!(sideways[1] >= 0.01, "with friction: {sideways:?}");
+}
