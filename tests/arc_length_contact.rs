@@ -372,3 +372,29 @@ fn an_arc_length_body_against_a_ball_is_refused_by_name() {
         "{text}"
     );
 }
+
+/// An arc-length body with friction, or beside another body, is refused with the reason.
+#[test]
+fn an_arc_length_body_with_friction_or_another_body_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = von_mises_scene(dir.path(), 4, "");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&scene, format!("{text}friction = 0.3\n")).unwrap();
+    let e = run_scene(&scene, 1).unwrap_err();
+    assert!(
+        e.contains("body 'von_mises'")
+            && e.contains("friction's history needs increments in the load's time"),
+        "{e}"
+    );
+    let other = text.replace(
+        "[[obstacles]]",
+        "[[bodies]]\nname = \"other\"\nnodes = \"t.nodes\"\nlinks = \"t.links\"\noffset = [0.0, 1.0]\n[[bodies.supports]]\nnodes = [1, 3]\nfix = [\"x\", \"y\"]\n[[obstacles]]",
+    );
+    std::fs::write(&scene, other).unwrap();
+    let e = run_scene(&scene, 1).unwrap_err();
+    assert!(
+        e.contains("body 'von_mises'")
+            && e.contains("the arc length is one body's constraint; the contact solver advances by load control"),
+        "{e}"
+    );
+}

@@ -23,7 +23,8 @@ use crate::Real;
 /// What solves a world's steps: one solver per body, or one for all bodies and their contacts.
 pub enum WorldSolver {
     /// One solver per body, in scene order: linear superposition, or Newton for a nonlinear
-    /// body (a scene without contact).
+    /// body (a scene without contact, or one arc-length body whose Newton holds the scene's
+    /// fixed half-spaces as stops).
     Bodies(Vec<BodySolver>),
     /// All bodies solved together with their contacts (a scene with obstacles or `[contact]`).
     Contact(Box<ContactSolver>),
@@ -64,8 +65,8 @@ impl<'w> Simulation<'w> {
                 },
             };
             // Breaking bodies in contact: nonlinear ones too (their members' stresses as the
-            // results report them), with friction too (see `ContactFracture`); an arc-length
-            // path is refused with contact for every body (the contact solver's own error).
+            // results report them), with friction too (see `ContactFracture`), but not along
+            // an arc-length path.
             for body in world.bodies.iter().filter(|b| breaks_members(b)) {
                 if let crate::linkage::PathMethod::ArcLength { .. } = body.newton.path {
                     return Err(refused(
