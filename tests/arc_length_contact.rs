@@ -8,7 +8,9 @@ use linkage::linkage::{
     stop_forces, Body, Dimension, Kinematics, Material, Member, NewtonEquilibrium, NodalLoad,
     PathMethod, Schedule, StepState, Stop, Support,
 };
+use linkage::scene::{load_scene, Simulation, StepResult};
 use nalgebra::Vector3;
+use std::path::Path;
 
 fn v(x: f64, y: f64) -> Vector3<f64> {
     Vector3::new(x, y, 0.0)
@@ -174,5 +176,225 @@ fn von_mises_truss_pressed_through_its_limit_point_onto_a_stop_by_arc_length() {
     assert!(
         last > peak,
         "the floor carries: λ {last} beyond the limit {peak}"
+    );
+}
+
+/// The scene file of the truss above against the floor: the same nodes, load (the closed-form
+/// limit load, written to round trip), arc length, tolerance and penalty; `extra` is appended.
+fn von_mises_scene(dir: &Path, steps: usize, extra: &str) -> std::path::PathBuf {
+    std::fs::write(dir.join("t.nodes"), format!("-{A} 0\n0 {H}\n{A} 0\n")).unwrap();
+    std::fs::write(dir.join("t.links"), "1 2\n2 3\n").unwrap();
+    let scene = dir.join("floor.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "floor"
+steps = {steps}
+[[materials]]
+name = "steel"
+youngs_modulus = 200e9
+area = 1e-4
+[[bodies]]
+name = "von_mises"
+nodes = "t.nodes"
+links = "t.links"
+kinematics = "large"
+[bodies.newton]
+tolerance = 1e-10
+[bodies.path]
+method = "arc_length"
+arc_length = 0.004
+[[bodies.supports]]
+nodes = [1, 3]
+fix = ["x", "y"]
+[[bodies.loads]]
+nodes = [2]
+force = [0.0, {}]
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, {}]
+normal = [0.0, 1.0]
+{extra}
+[contact]
+penalty = {K_STOP:e}
+"#,
+            -von_mises_limit(),
+            H - W_STOP,
+        ),
+    )
+    .unwrap();
+    scene
+}
+
+/// Steps 1..=steps of a scene, as written; the error as its text.
+fn run_scene(scene: &Path, steps: usize) -> Result<Vec<StepResult>, String> {
+    let world = load_scene(scene).expect("the scene reads");
+    let text = |e: linkage::scene::RunError| format!("{e:#}");
+    let mut sim = Simulation::new(&world).map_err(text)?;
+    (1..=steps)
+        .map(|k| sim.step(k).map(|(r, _)| r).map_err(text))
+        .collect()
+}
+
+/// The same truss from a scene file with a `half_space` obstacle: routed to the body's own
+/// Newton with the floor as a stop, the path rises to the limit load, falls, and rises on the
+/// floor; every step agrees with the library path above (λ and the apex, 1e-9), and the
+/// written contact force on the floor (per node and in the summary's totals) balances the
+/// supports' reactions and the load (1e-8 of the load).
+#[test]
+fn von_mises_truss_scene_with_a_half_space_follows_the_arc_length_onto_the_floor() {
+    let dir = tempfile::tempdir().unwrap();
+    let steps = 60;
+    let scene = von_mises_scene(dir.path(), steps, "");
+    let world = load_scene(&scene).expect("the scene reads");
+    let mut sim = Simulation::new(&world).expect("routed to the body's own Newton");
+    let library = trace(&von_mises(), vec![floor()], steps);
+    let (mut peak, mut fell, mut touched): (f64, bool, Option<usize>) = (0.0, false, None);
+    // The largest differences from the library path (λ, apex in m) and off balance (N / N).
+    let (mut d_lambda, mut d_apex, mut off): (f64, f64, f64) = (0.0, 0.0, 0.0);
+    // The default penetration tolerance: 1% of the bars' length.
+    let tolerance = 0.01 * (A * A + H * H).sqrt();
+    for (k, (state, pushed)) in library.iter().enumerate() {
+        let (result, summary) = sim.step(k + 1).expect("step solves");
+        let lambda = state.load_factor.unwrap();
+        assert!(
+            (result.load_factor - lambda).abs() <= 1e-9
+                && (summary.load_factor - lambda).abs() <= 1e-9,
+            "step {}: λ {} against {lambda}",
+            k + 1,
+            result.load_factor
+        );
+        d_lambda = d_lambda.max((result.load_factor - lambda).abs());
+        let body = &result.bodies[0];
+        let w = -body.displacements[1][1];
+        d_apex = d_apex.max((w + state.displacements[1].y).abs());
+        assert!(
+            (w + state.displacements[1].y).abs() <= 1e-9,
+            "step {}: apex {w} against {}",
+            k + 1,
+            -state.displacements[1].y
+        );
+        let written: Vector3<f64> = body
+            .contacts
+            .iter()
+            .map(|c| {
+                assert_eq!((c.node, c.with.as_str()), (2, "floor"));
+                v(c.force[0], c.force[1])
+            })
+            .sum();
+        let reactions: Vector3<f64> = body
+            .reactions
+            .iter()
+            .map(|r| v(r.force[0], r.force[1]))
+            .sum();
+        let applied: Vector3<f64> = body.loads.iter().map(|r| v(r.force[0], r.force[1])).sum();
+        let balance = -(reactions + applied);
+        off = off.max((written - balance).norm() / applied.norm().max(1.0));
+        assert!(
+            (written - balance).norm() <= 1e-8 * applied.norm().max(1.0),
+            "step {}: floor {written} against supports and load {balance}",
+            k + 1
+        );
+        assert!((written - pushed).norm() <= 1e-9 * pushed.norm().max(1.0));
+        if pushed.norm() > 0.0 {
+            touched.get_or_insert(k);
+            assert_eq!(summary.contact_forces.len(), 1, "step {}", k + 1);
+            let total = &summary.contact_forces[0];
+            assert_eq!(
+                (total.body.as_str(), total.with.as_str()),
+                ("von_mises", "floor")
+            );
+            assert!((v(total.force[0], total.force[1]) - written).norm() <= 1e-9 * written.norm());
+            assert!((summary.max_penetration - (w - W_STOP)).abs() <= 1e-12);
+            assert_eq!(summary.slipping, 1, "frictionless: the apex slips");
+            // Deeper than the contact solver's tolerance: its warning.
+            let warned = summary.warnings.iter().any(|w| {
+                w.contains("node 2 of body 'von_mises' is") && w.contains("inside 'floor'")
+            });
+            assert_eq!(
+                warned,
+                w - W_STOP > tolerance,
+                "step {}: {:?}",
+                k + 1,
+                summary.warnings
+            );
+        } else {
+            assert!(body.contacts.is_empty() && summary.contact_forces.is_empty());
+            fell |= lambda < peak - 0.01;
+            peak = peak.max(lambda);
+        }
+    }
+    let touched = touched.expect("the apex reaches the floor");
+    let last = library.last().unwrap().0.load_factor.unwrap();
+    println!(
+        "scene: peak λ {peak:.6}, floor reached at step {}, λ {last:.4} at step {steps}; from the library path at most {d_lambda:.1e} in λ, {d_apex:.1e} m at the apex; floor against supports and load {off:.1e} of the load",
+        touched + 1
+    );
+    assert!((peak - 1.0).abs() <= 2e-3 && fell && last > peak);
+}
+
+/// An arc-length body against a moving obstacle is refused before anything is solved, naming
+/// the body, the obstacle, the reason and the remedy.
+#[test]
+fn an_arc_length_body_against_a_moving_obstacle_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = von_mises_scene(
+        dir.path(),
+        4,
+        "[[obstacles]]\nname = \"press\"\nshape = \"half_space\"\npoint = [0.0, 0.3]\nnormal = [0.0, -1.0]\ntravel = [0.0, -0.1]\n",
+    );
+    let text = run_scene(&scene, 1).unwrap_err();
+    assert!(
+        text.contains("body 'von_mises'")
+            && text.contains("obstacle 'press' moves")
+            && text.contains(
+                "a moving obstacle sets the path's time, which the arc length sets itself"
+            )
+            && text.contains("method = \"schedules\""),
+        "{text}"
+    );
+}
+
+/// An arc-length body against a ball is refused: only half-spaces are stops so far.
+#[test]
+fn an_arc_length_body_against_a_ball_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = von_mises_scene(
+        dir.path(),
+        4,
+        "[[obstacles]]\nname = \"ball\"\nshape = \"ball\"\ncenter = [0.0, 0.5]\nradius = 0.1\n",
+    );
+    let text = run_scene(&scene, 1).unwrap_err();
+    assert!(
+        text.contains("body 'von_mises'")
+            && text.contains("obstacle 'ball' is not a half-space: only half-spaces are stops of an arc-length body so far"),
+        "{text}"
+    );
+}
+
+/// An arc-length body with friction, or beside another body, is refused with the reason.
+#[test]
+fn an_arc_length_body_with_friction_or_another_body_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = von_mises_scene(dir.path(), 4, "");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&scene, format!("{text}friction = 0.3\n")).unwrap();
+    let e = run_scene(&scene, 1).unwrap_err();
+    assert!(
+        e.contains("body 'von_mises'")
+            && e.contains("friction's history needs increments in the load's time"),
+        "{e}"
+    );
+    let other = text.replace(
+        "[[obstacles]]",
+        "[[bodies]]\nname = \"other\"\nnodes = \"t.nodes\"\nlinks = \"t.links\"\noffset = [0.0, 1.0]\n[[bodies.supports]]\nnodes = [1, 3]\nfix = [\"x\", \"y\"]\n[[obstacles]]",
+    );
+    std::fs::write(&scene, other).unwrap();
+    let e = run_scene(&scene, 1).unwrap_err();
+    assert!(
+        e.contains("body 'von_mises'")
+            && e.contains("the arc length is one body's constraint; the contact solver advances by load control"),
+        "{e}"
     );
 }

@@ -57,12 +57,16 @@ pub enum ContactError {
     /// The sparse factorization failed for another reason.
     #[error("the sparse factorization of the bodies in contact failed: {0}")]
     Factorization(CholeskyError),
-    /// The arc-length method is not available with contact: the load factor of one body's
-    /// path does not say where the obstacles and the other bodies are.
-    #[error("body '{body}': [bodies.path] method = \"arc_length\" cannot be combined with contact (obstacles or a [contact] table): the arc length scales one body's loads by a factor it finds, while the obstacles' travel and the other bodies follow their schedules. Use the default load schedules; a contact step that Newton cannot solve at once is crossed in halved increments (see [bodies.newton] max_cuts)")]
+    /// An arc-length path in a scene with contact that is not one body against fixed
+    /// frictionless half-spaces (which the body's own Newton takes as stops).
+    #[error("body '{body}': [bodies.path] method = \"arc_length\" with contact (obstacles or a [contact] table) is followed only for one body against fixed, frictionless half_space obstacles; here {reason}. To run it: {remedy}")]
     ArcLength {
         /// Body name.
         body: String,
+        /// Why this scene is not one the arc length can follow.
+        reason: String,
+        /// What to change.
+        remedy: String,
     },
     /// A 3D body's patches cannot be a contact surface.
     #[error("body '{body}': its patches cannot be a contact surface: {}", match problem {

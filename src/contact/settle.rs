@@ -110,6 +110,8 @@ impl ContactSolver {
             if let PathMethod::ArcLength { .. } = body.newton.path {
                 return Err(ContactError::ArcLength {
                     body: body.name.clone(),
+                    reason: "the contact solver advances by load control, while the arc length scales the body's loads by a factor it finds".to_string(),
+                    remedy: "use the default load schedules; a contact step that Newton cannot solve at once is crossed in halved increments (see [bodies.newton] max_cuts)".to_string(),
                 });
             }
             let dofs = DofMap::new(body);

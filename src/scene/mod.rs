@@ -37,6 +37,7 @@ pub use self::vtu_arrays::VtkEncoding;
 pub use self::world::{OutputSettings, World};
 pub use self::writers::DrawResults;
 
+mod arc_length_stops;
 pub mod atomic_file;
 pub mod batch;
 mod bounds;

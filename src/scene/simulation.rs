@@ -2,10 +2,12 @@
 //! and the step's result and summary line.
 
 use crate::contact::{
-    self_contact_on, ContactFracture, ContactSolver, FractureStop, NodeContact, SelfContactWatch,
+    penetration_tolerance, self_contact_on, ContactFracture, ContactSolver, FractureStop,
+    NodeContact, SelfContactWatch,
 };
 use crate::linkage::fracture::{breaks_members, BreakEvent, FractureState};
-use crate::linkage::{Body, BodySolver, PhaseTimes, SolveError, StepState};
+use crate::linkage::{Body, BodySolver, NewtonEquilibrium, PhaseTimes, SolveError, StepState};
+use crate::scene::arc_length_stops::{arc_length_stops, stop_contacts};
 use crate::scene::capacity::CapacityWatch;
 use crate::scene::contact_concentration::concentrated_contact_warnings;
 use crate::scene::instability::InstabilityWatch;
@@ -21,7 +23,8 @@ use crate::Real;
 /// What solves a world's steps: one solver per body, or one for all bodies and their contacts.
 pub enum WorldSolver {
     /// One solver per body, in scene order: linear superposition, or Newton for a nonlinear
-    /// body (a scene without contact).
+    /// body (a scene without contact, or one arc-length body whose Newton holds the scene's
+    /// fixed half-spaces as stops).
     Bodies(Vec<BodySolver>),
     /// All bodies solved together with their contacts (a scene with obstacles or `[contact]`).
     Contact(Box<ContactSolver>),
@@ -62,8 +65,8 @@ impl<'w> Simulation<'w> {
                 },
             };
             // Breaking bodies in contact: nonlinear ones too (their members' stresses as the
-            // results report them), with friction too (see `ContactFracture`); an arc-length
-            // path is refused with contact for every body (the contact solver's own error).
+            // results report them), with friction too (see `ContactFracture`), but not along
+            // an arc-length path.
             for body in world.bodies.iter().filter(|b| breaks_members(b)) {
                 if let crate::linkage::PathMethod::ArcLength { .. } = body.newton.path {
                     return Err(refused(
@@ -74,7 +77,22 @@ impl<'w> Simulation<'w> {
                 }
             }
         }
-        let solver = if world.has_contact() {
+        // One body on an arc-length path against fixed half-spaces: its own Newton with one
+        // stop per half-space; any other arc-length scene with contact is refused here.
+        let stops = if world.has_contact() {
+            arc_length_stops(world)?
+        } else {
+            None
+        };
+        let solver = if let Some(stops) = stops {
+            let mut newton =
+                NewtonEquilibrium::new(&world.bodies[0]).map_err(|source| RunError::Solve {
+                    scene: world.source.clone(),
+                    source,
+                })?;
+            newton.set_stops(stops);
+            WorldSolver::Bodies(vec![BodySolver::Nonlinear(Box::new(newton))])
+        } else if world.has_contact() {
             let contact =
                 ContactSolver::new(&world.bodies, &world.obstacles, world.contact.clone())
                     .map_err(|source| RunError::Contact {
@@ -94,7 +112,7 @@ impl<'w> Simulation<'w> {
                 })?;
             WorldSolver::Bodies(solvers)
         };
-        let fracture = if world.has_contact() {
+        let fracture = if matches!(solver, WorldSolver::Contact(_)) {
             ContactFracture::new(&world.bodies).map_err(|source| RunError::Solve {
                 scene: world.source.clone(),
                 source,
@@ -142,7 +160,10 @@ impl<'w> Simulation<'w> {
             self.solve_with_contact(step, &mut summary)?
         } else {
             match self.solve_bodies(step, &mut summary)? {
-                Ok(states) => (states, Vec::new()),
+                Ok(states) => {
+                    let contacts = self.stop_contacts(step, &mut summary);
+                    (states, contacts)
+                }
                 Err(touch) => {
                     self.switch_to_contact(step)?;
                     summary = empty_summary(step, world.load_factor(step));
@@ -393,6 +414,55 @@ impl<'w> Simulation<'w> {
             }
         }
         Ok(Ok(states))
+    }
+
+    /// Per body of a world solved body by body, what its stops (fixed half-spaces of an
+    /// arc-length body, see [`arc_length_stops`]) do at the step just solved, as a contact
+    /// step reports it: per body its pressed nodes; each stop's total force and the deepest
+    /// node's depth go into `summary`. Empty without stops.
+    fn stop_contacts(&self, step: usize, summary: &mut StepSummary) -> Vec<Vec<NodeContact>> {
+        let WorldSolver::Bodies(solvers) = &self.solver else {
+            return Vec::new();
+        };
+        let mut out = Vec::with_capacity(solvers.len());
+        for (body, solver) in self.world.bodies.iter().zip(solvers) {
+            let BodySolver::Nonlinear(newton) = solver else {
+                out.push(Vec::new());
+                continue;
+            };
+            let (contacts, totals) = stop_contacts(body, newton.stops(), newton.displacement());
+            let d = body.dimension.dofs_per_node();
+            for (with, force) in totals {
+                summary.contact_forces.push(PairForce {
+                    body: body.name.clone(),
+                    with,
+                    force: force.as_slice()[..d].to_vec(),
+                });
+            }
+            summary.max_penetration = contacts
+                .iter()
+                .map(|c| c.depth)
+                .fold(summary.max_penetration, Real::max);
+            // Frictionless: every contact slips; one deeper than the contact tolerance warns
+            // as the contact solver's does.
+            summary.slipping += contacts.len();
+            let tolerance = self
+                .world
+                .contact
+                .tolerance
+                .unwrap_or_else(|| penetration_tolerance(body));
+            for c in contacts.iter().filter(|c| c.depth > tolerance) {
+                summary.warnings.push(format!(
+                    "step {step}: node {} of body '{}' is {:.3e} m inside '{}' (tolerance {tolerance:.3e} m): raise [contact] penalty",
+                    c.node + 1,
+                    body.name,
+                    c.depth,
+                    c.with
+                ));
+            }
+            out.push(contacts);
+        }
+        out
     }
 
     /// Put the world on the contact solver and bring it to the start of `step`: steps 0 to
