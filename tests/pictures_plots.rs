@@ -543,3 +543,38 @@ fn a_plot_of_an_unknown_support_is_an_error_naming_the_file_and_line() {
         assert!(err.contains(says), "{output}: {err}");
     }
 }
+
+#[test]
+fn a_node_set_plot_of_the_paper_square_shows_its_load_against_its_displacement() {
+    // The paper's square, 200 N in +x at node 2: the force at node 2 (its load) along the
+    // axis of the largest force (x) against node 2's x displacement.
+    let tmp = tempfile::tempdir().unwrap();
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    for f in ["square.nodes", "square.links"] {
+        std::fs::copy(scenes.join(f), tmp.path().join(f)).unwrap();
+    }
+    let text = std::fs::read_to_string(scenes.join("paper_square.toml")).unwrap();
+    let file = tmp.path().join("square.toml");
+    std::fs::write(
+        &file,
+        format!("{text}\n[output]\nplot = {{ body = \"square\", nodes = [2] }}\n"),
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    ok(&[
+        "run".as_ref(),
+        file.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--png".as_ref(),
+    ]);
+    let dir = out.join("paper_square");
+    let p = points(&dir, "load_displacement", ("displacement_m", "force_N"));
+    assert_eq!(p.len(), 2);
+    let last = json(&dir.join("steps/0001.json"));
+    let ux = last["bodies"][0]["displacements"][1][0].as_f64().unwrap();
+    assert_eq!(p[0].0, "node 2 of body 'square'");
+    assert!(p[0].1.abs() < 1e-15 && p[0].2.abs() < 1e-9, "{:?}", p[0]);
+    assert!((p[1].1 - ux).abs() <= 1e-15, "{} against {ux}", p[1].1);
+    assert!((p[1].2 - 200.0).abs() <= 1e-9, "{}", p[1].2);
+}
