@@ -84,7 +84,7 @@ fn ball_obj() -> String {
 }
 
 /// Two balls prepared from `ball.obj`, the upper pressed 10 mm down onto the lower (contact
-/// between bodies), in `dir/balls.toml`: some ten seconds of work, METIS orderings first.
+/// between bodies), in `dir/balls.toml`: METIS orderings, then the contact Newton (0.3 s to 5 s).
 fn balls_scene(dir: &Path) -> PathBuf {
     std::fs::write(dir.join("ball.obj"), ball_obj()).unwrap();
     let scene = dir.join("balls.toml");
@@ -250,8 +250,24 @@ fn sigterm_and_sigint_at_ten_moments_of_a_contact_run_of_meshed_balls_exit_130()
     let dir = tempfile::tempdir().unwrap();
     let scene = balls_scene(dir.path());
     let out = dir.path().join("out");
+    // The moments are spread over the first 60 % of the run's own length, timed once here
+    // (into another folder; whatever its outcome: the contact of these faceted balls stalls
+    // in its Newton past a few steps, issue 32 contact case 2), so each signal comes mid-run.
+    let timed = Instant::now();
+    let o = linkage()
+        .args(["run".as_ref(), scene.as_os_str()])
+        .arg("--out")
+        .arg(dir.path().join("timed"))
+        .output()
+        .unwrap();
+    let length = timed.elapsed().as_secs_f64();
+    assert!(
+        o.status.code().is_some(),
+        "the uninterrupted run crashed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let earlier = earlier_results(dir.path(), &out, "balls");
-    let moments: Vec<f64> = (1..=10).map(|k| 0.25 * k as f64).collect();
+    let moments: Vec<f64> = (1..=10).map(|k| 0.06 * length * k as f64).collect();
     check_stops(&scene, &[], &out, "balls", &earlier, &moments);
 }
 
@@ -612,8 +628,11 @@ fn sigterm_and_sigint_while_render_reads_the_results_exit_130() {
         assert_eq!(s.code, Some(130), "{what}: {}", s.stderr);
         assert!(s.seconds < 2.0, "{what}: {:.2} s to stop", s.seconds);
         assert!(
+            // While reading the stored results, or (the reading done, on a fast machine)
+            // while writing the GLB: stopped either way, with nothing changed.
             s.stderr
-                .contains("interrupted while reading the stored results"),
+                .contains("interrupted while reading the stored results")
+                || s.stderr.contains("interrupted: stopping now"),
             "{what}: {}",
             s.stderr
         );

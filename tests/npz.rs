@@ -95,7 +95,15 @@ fn both_formats_read_back_equal_to_the_results_in_memory_bit_for_bit() {
             let ext = format.extension();
             let mut files = listing(&dir);
             files.retain(|f| f != "png" && f != "anim.gif");
-            assert_eq!(files, [format.model_file(), "steps", "summary.json"]);
+            assert_eq!(
+                files,
+                [
+                    format.model_file(),
+                    "plot_settings.json",
+                    "steps",
+                    "summary.json"
+                ]
+            );
             let steps = listing(&dir.join("steps"));
             assert_eq!(steps.len(), world.steps + 1);
             assert!(steps.iter().all(|s| s.ends_with(ext)), "{steps:?}");

@@ -60,7 +60,7 @@ pub struct PlotPlace {
 pub struct PlotSettings {
     /// `plot_node`: plot the load factor against this node's displacement and the reaction
     /// total against the load factor; `None`: against the largest displacement of any node.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub node: Option<PlotNode>,
     /// `plot_obstacle`: the obstacle whose push is the load: the load–displacement plot is the
     /// force the bodies receive from it against its travel (see
