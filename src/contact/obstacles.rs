@@ -131,9 +131,21 @@ impl Obstacles {
         x: &Vector3<Real>,
         offset: &Vector3<Real>,
     ) -> Option<ObstacleProjection> {
-        let (handle, _) = self.entries.get(index)?;
+        let (handle, obstacle) = self.entries.get(index)?;
         let collider = self.colliders.get(*handle)?;
         let local = x - offset;
+        if let ObstacleShape::HalfSpace { point, normal } = &obstacle.shape {
+            // A plane's normal is its own, not the direction to the nearest point: at a depth
+            // of 1e-10 m that direction carries the coordinates' round-off (1e-17 m) as 1e-7
+            // of a turn, which a tilted floor's friction sees (issue 32, contact case 1).
+            let n = normal.normalize();
+            let depth = (point - local).dot(&n);
+            return Some(ObstacleProjection {
+                depth,
+                normal: Some(n),
+                surface: local + n * depth + offset,
+            });
+        }
         let projection =
             collider
                 .shape()
@@ -197,6 +209,24 @@ mod tests {
             )
             .unwrap();
         assert!((p.depth - 0.5).abs() < 1e-15, "moved up by 1: {p:?}");
+    }
+
+    #[test]
+    fn a_tilted_half_space_gives_its_own_normal_at_any_depth() {
+        // Tilted 20°: a node 1e-10 m inside, at coordinates of 0.1 m (round-off 1e-17 m), gets
+        // the plane's normal to round-off, not the direction to its nearest point (off by
+        // 1e-7 there).
+        let (s, c) = 20f64.to_radians().sin_cos();
+        let n = Vector3::new(-s, c, 0.0);
+        let o = one(ObstacleShape::HalfSpace {
+            point: Vector3::zeros(),
+            normal: n * 2.0,
+        });
+        let x = Vector3::new(0.1 * c, 0.1 * s, 0.05) - n * 1e-10;
+        let p = o.project(0, &x, &Vector3::zeros()).unwrap();
+        assert!((p.normal.unwrap() - n).norm() < 1e-15);
+        assert!((p.depth - 1e-10).abs() < 1e-16, "{}", p.depth);
+        assert!((p.surface - (x + n * p.depth)).norm() < 1e-16);
     }
 
     #[test]
