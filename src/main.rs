@@ -647,9 +647,14 @@ fn run_scenes(
                     say!("      {teeth} softening tooth/teeth passed");
                 }
                 if let Some(c) = &summary.collapse {
+                    // The collapse state is written as the last step when it is known.
+                    let last = summary.steps.last().filter(|l| l.collapse).map_or_else(
+                        || format!("steps 0-{} written", c.step.saturating_sub(1)),
+                        |l| format!("steps 0-{} written, the last the state it collapsed in", l.step),
+                    );
                     say!(
-                        "      collapse: body '{}' at step {} (load factor {}): breaking member {} left its supported part a mechanism; steps 0-{} written",
-                        c.body, c.step, c.load_factor, c.member, c.step.saturating_sub(1)
+                        "      collapse: body '{}' at step {} (load factor {}): breaking member {} left its supported part a mechanism; {last}",
+                        c.body, c.step, c.load_factor, c.member
                     );
                 }
             }

@@ -373,9 +373,10 @@ fn an_arc_length_body_against_a_ball_is_refused_by_name() {
     );
 }
 
-/// An arc-length body with friction, or beside another body, is refused with the reason.
+/// An arc-length body with friction, beside another body, or with self-contact on is refused
+/// with the reason.
 #[test]
-fn an_arc_length_body_with_friction_or_another_body_is_refused_by_name() {
+fn an_arc_length_body_with_friction_another_body_or_self_contact_is_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let scene = von_mises_scene(dir.path(), 4, "");
     let text = std::fs::read_to_string(&scene).unwrap();
@@ -395,6 +396,14 @@ fn an_arc_length_body_with_friction_or_another_body_is_refused_by_name() {
     assert!(
         e.contains("body 'von_mises'")
             && e.contains("the arc length is one body's constraint; the contact solver advances by load control"),
+        "{e}"
+    );
+    std::fs::write(&scene, format!("{text}self = true\n")).unwrap();
+    let e = run_scene(&scene, 1).unwrap_err();
+    assert!(
+        e.contains("body 'von_mises'")
+            && e.contains("self-contact is on")
+            && e.contains("[contact] self = false"),
         "{e}"
     );
 }

@@ -101,7 +101,13 @@ force = [0.0, -80000.0]
     assert_eq!(summary.breaks.len(), 1);
     assert_eq!((summary.breaks[0].step, summary.breaks[0].member), (2, 1));
     assert!(close(summary.breaks[0].load_factor, expected, 1e-9));
-    assert_eq!(summary.steps.len(), 2, "steps 0 and 1 solved");
+    // Steps 0 and 1 solved, and the collapse state written as step 2 (flagged).
+    assert_eq!(
+        summary.steps.len(),
+        3,
+        "steps 0 and 1 solved, step 2 the collapse"
+    );
+    assert!(summary.steps[2].collapse && !summary.steps[1].collapse);
     assert!(summary.failure.is_none());
     let step1 = step_file(dir.path(), "determinate", 1).expect("step 1 written");
     let body = &step1["bodies"][0];
@@ -113,7 +119,10 @@ force = [0.0, -80000.0]
         80000.0 / 3.0 / 2.0,
         1e-9
     ));
-    assert!(step_file(dir.path(), "determinate", 2).is_none());
+    // The collapse state is written as step 2: the chord broken, flagged.
+    let step2 = step_file(dir.path(), "determinate", 2).expect("the collapse state written");
+    assert_eq!(step2["bodies"][0]["broken"], serde_json::json!([1]));
+    assert_eq!(step2["bodies"][0]["collapse"], serde_json::json!(true));
     let text = std::fs::read_to_string(dir.path().join("out/determinate/summary.json")).unwrap();
     assert!(text.contains("\"collapse\""));
 }
@@ -171,8 +180,10 @@ force = [0.0, {}]
         summary.breaks
     );
     assert!(close(collapse.load_factor, p2, 1e-9), "{collapse:?}");
-    // Steps 0 to 22 solved, nothing after the collapse; nothing fell off before it.
-    assert_eq!(summary.steps.len(), 23);
+    // Steps 0 to 22 solved, the collapse state as step 23 (all three bars broken), nothing
+    // after it; nothing fell off before it.
+    assert_eq!(summary.steps.len(), 24);
+    assert!(summary.steps[23].collapse && summary.steps[23].broken == Some(3));
     assert!(summary
         .steps
         .iter()
@@ -187,7 +198,14 @@ force = [0.0, {}]
         p / (1.0 + 1.0 / 2f64.sqrt()),
         1e-9
     ));
-    assert!(step_file(dir.path(), "three_bar", 23).is_none());
+    // The collapse state is step 23, flagged, with all three bars broken; nothing after it.
+    let step23 = step_file(dir.path(), "three_bar", 23).expect("the collapse state written");
+    assert_eq!(step23["bodies"][0]["collapse"], serde_json::json!(true));
+    assert_eq!(
+        step23["bodies"][0]["broken"].as_array().map(Vec::len),
+        Some(3)
+    );
+    assert!(step_file(dir.path(), "three_bar", 24).is_none());
 }
 
 /// The same truss made asymmetric (member 1 weaker by 1 %, so it breaks alone): after the
@@ -226,7 +244,9 @@ failure = "break"
     // Member 1 alone carries P/(2 cos 45°) at its break: 0.99 × 2 cos 45° f_t A.
     let p = 0.99 * 2.0 * std::f64::consts::FRAC_PI_4.cos() / 3.0;
     assert!(close(collapse.load_factor, p, 1e-9), "{collapse:?}");
-    assert_eq!(summary.steps.len(), 23);
+    // Steps 0 to 22, and the collapse state as step 23.
+    assert_eq!(summary.steps.len(), 24);
+    assert!(summary.steps[23].collapse);
 }
 
 /// A piece breaking off a structure that goes on carrying load: a stable triangle of strong
@@ -891,6 +911,85 @@ displacement = [0.001, 0.0]
     assert!(w.contains("it has failed"), "{w}");
 }
 
+/// Case 7 of issue 32, **failure that the results hide**, under force control: the same
+/// brittle plate with a hole pulled by 20 kN on its right edge over 20 steps. At step 7 the
+/// first members beside the hole reach their strength and a cascade of breaks crosses the
+/// plate until it is a mechanism: a collapse. The collapse state used not to be written, so
+/// the last frame (step 6) showed none of the 23 broken members. The state it collapsed in
+/// is the run's last stored step: every member the run broke shown broken (the displacements
+/// at the load the cascade reached), flagged as the collapse in summary.json's step line and
+/// the step file, and drawn (its frame's title says "collapsed": a unit test of the overlay).
+#[test]
+fn failure_that_the_results_hide_under_force_control() {
+    let dir = tempfile::tempdir().unwrap();
+    let here = std::env::current_dir()
+        .unwrap()
+        .join("scenes/plate_with_hole.txt");
+    let scene = dir.path().join("plate.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "plate"
+steps = 20
+[[materials]]
+name = "brittle"
+youngs_modulus = 200e9
+area = 1e-5
+tensile_strength = 100e6
+failure = "break"
+[[bodies]]
+name = "plate"
+outline = {{ file = "{}", spacing = 0.02 }}
+material = "brittle"
+[[bodies.supports]]
+on_line = {{ point = [0.0, 0.0], direction = [0.0, 1.0] }}
+fix = ["x"]
+[[bodies.supports]]
+nearest = [0.0, 0.0]
+fix = ["y"]
+[[bodies.loads]]
+on_line = {{ point = [0.4, 0.0], direction = [0.0, 1.0] }}
+total_force = [20000.0, 0.0]
+"#,
+            here.display()
+        ),
+    )
+    .unwrap();
+    let world = load_scene(&scene).unwrap();
+    let summary = run(&world, &dir.path().join("out"), &|| {}).expect("a result");
+    let collapse = summary.collapse.as_ref().expect("a collapse");
+    assert!(summary.failure.is_none());
+    // Every break is of the collapse step (a cascade from the first).
+    assert!(summary.breaks.len() > 2, "{:?}", summary.breaks);
+    assert!(summary.breaks.iter().all(|b| b.step == collapse.step));
+    // The collapse step is the last line of the summary, flagged, and the last step stored.
+    assert_eq!(summary.steps.len(), collapse.step + 1);
+    let line = summary.steps.last().unwrap();
+    assert_eq!(line.step, collapse.step);
+    assert!(line.collapse && !summary.steps[..collapse.step].iter().any(|l| l.collapse));
+    assert_eq!(line.broken, Some(summary.breaks.len()));
+    let last = step_file(dir.path(), "plate", collapse.step).expect("the collapse step written");
+    assert!(step_file(dir.path(), "plate", collapse.step + 1).is_none());
+    assert_eq!(last["load_factor"].as_f64(), Some(line.load_factor));
+    // The body's fracture keys are written flat in its entry.
+    let fracture = &last["bodies"][0];
+    assert_eq!(fracture["collapse"].as_bool(), Some(true));
+    let mut broken: Vec<u64> = fracture["broken"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m.as_u64().unwrap())
+        .collect();
+    broken.sort_unstable();
+    let mut expected: Vec<u64> = summary.breaks.iter().map(|b| b.member as u64).collect();
+    expected.sort_unstable();
+    assert_eq!(broken, expected);
+    // The step before: nothing broken, not flagged.
+    let before = step_file(dir.path(), "plate", collapse.step - 1).unwrap();
+    assert!(before["bodies"][0]["collapse"].is_null());
+    assert!(before["bodies"][0]["broken"].as_array().unwrap().is_empty());
+}
+
 /// Gravity with fracture (a pair of the table in docs/SCENES.md): a vertical bar (node 1 held
 /// at (0, 1), node 2 below it at the origin held sideways, length 1 m, ρ = 7850 kg/m³, g = 9.81 m/s², its
 /// weight W = ρ A L g at full value from step 1 on) with P up to 40 kN down at node 2 over 4
@@ -942,7 +1041,9 @@ force = [0.0, -40000.0]
     assert_eq!((summary.breaks[0].step, summary.breaks[0].member), (3, 1));
     let collapse = summary.collapse.as_ref().expect("a collapse");
     assert_eq!((collapse.step, collapse.member), (3, 1));
-    assert_eq!(summary.steps.len(), 3);
+    // Steps 0 to 2, and the collapse state as step 3.
+    assert_eq!(summary.steps.len(), 4);
+    assert!(summary.steps[3].collapse);
     assert!(
         close(summary.breaks[0].load_factor, expected, 1e-9),
         "{} against {expected}",

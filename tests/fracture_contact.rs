@@ -506,8 +506,12 @@ penalty = 1e9
         assert!(close(summary.breaks[1].load_factor, p2 / p, 1e-9));
         assert!(close(summary.breaks[2].load_factor, p2 / p, 1e-9));
         assert!(summary.breaks[1].load_factor < summary.breaks[0].load_factor);
-        assert_eq!(summary.steps.len(), 1, "step 0 only");
     }
+    // Step 0, and without contact the state it collapsed in, flagged (the contact path does not
+    // write that state yet).
+    assert_eq!(with.steps.len(), 1, "step 0 only");
+    assert_eq!(without.steps.len(), 2);
+    assert!(without.steps[1].collapse && !without.steps[0].collapse);
     for (a, b) in with.breaks.iter().zip(&without.breaks) {
         assert!(close(a.load_factor, b.load_factor, 1e-9), "{a:?} {b:?}");
     }

@@ -53,6 +53,7 @@ fn at_rest(model: &ModelFile, broken: &[Vec<usize>]) -> StepResult {
                     broken: list.clone(),
                     breaks: vec![],
                     fallen: vec![],
+                    collapse: false,
                 }),
                 velocities: vec![],
             })

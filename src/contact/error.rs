@@ -29,6 +29,21 @@ pub enum ContactError {
         /// Active contacts at the end.
         contacts: usize,
     },
+    /// A body touching surfaces that, with its supports, leave some of its rigid motions free
+    /// (a frictionless floor under a body without supports): named, with the part of its
+    /// loads along them when there is one (then it slides).
+    #[error("step {step}: body '{body}' {}", free_text(motions, push))]
+    Free {
+        /// The step.
+        step: usize,
+        /// Body name.
+        body: String,
+        /// The free motions in words ("slide along x and z and turn about y").
+        motions: String,
+        /// The direction ("along x") and size (N) of the part of its loads along the free
+        /// slides, when there is one.
+        push: Option<(String, Real)>,
+    },
     /// A body is a mechanism (nodes move without stretching a member) and no contact held it.
     #[error(
         "step {step}: {mechanism}; no contact held it either in the contact iterations allowed"
@@ -110,6 +125,19 @@ pub enum ContactError {
         /// loads pressing it on them.
         capacity: Real,
     },
+    /// A body pushed along its contacts by exactly what friction can hold (to 1e-6): at the
+    /// edge of sliding, where no state sticks firmly.
+    #[error("step {step}: body '{body}' is at the edge of sliding: its loads push it along its contacts with {load:.6e} N, the {capacity:.6e} N (μ times the normal force) friction can hold at most, so the answer is friction at its limit μ N with the slip left undetermined, and the solver finds no state that settles. Lower the tangential load a little (it then sticks) or raise it (it slides), raise [contact] friction, or hold the body with a support")]
+    EdgeOfSliding {
+        /// The step.
+        step: usize,
+        /// Body name.
+        body: String,
+        /// The tangential part of the body's applied loads at the step, N.
+        load: Real,
+        /// The largest tangential force its contacts can hold, N.
+        capacity: Real,
+    },
     /// A time step was given another number of inertia terms than there are bodies.
     #[error("a time step was given {terms} inertia terms for {bodies} bodies: give one per body, in scene order")]
     InertiaCount {
@@ -147,4 +175,16 @@ pub enum ContactError {
         /// The step.
         step: usize,
     },
+}
+
+/// The text of [`ContactError::Free`] after the body's name.
+fn free_text(motions: &str, push: &Option<(String, Real)>) -> String {
+    match push {
+        Some((direction, force)) => format!(
+            "slides {direction}: its loads push it {direction} with {force:.6e} N, along the surface it rests on, and nothing resists that motion (the contact has no friction), so it has no static equilibrium (free: {motions}). Add friction or a support that holds it"
+        ),
+        None => format!(
+            "can {motions}: nothing holds it there (its supports and contacts leave these rigid motions free, so its equilibrium is not determined); add friction or a support"
+        ),
+    }
 }

@@ -23,6 +23,9 @@ use nalgebra::Vector3;
 use std::collections::HashMap;
 use std::time::Instant;
 
+/// A tangential load within this fraction of μ N is at the edge of sliding.
+const EDGE: Real = 1e-6;
+
 /// What an increment is undone to: the last converged state.
 pub(crate) struct Converged {
     u: Vec<Vec<Real>>,
@@ -219,7 +222,8 @@ impl ContactSolver {
 
     /// The sliding of a body at `step` of `steps`, from the current state: a body whose
     /// applied loads at the step have a part along its contacts (perpendicular to the sum of
-    /// their normal forces) beyond the `Σ μ f_N` they hold there. `None` when no body is.
+    /// their normal forces) beyond the `Σ μ f_N` they hold there, or equal to it to within
+    /// `EDGE` ([`ContactError::EdgeOfSliding`]). `None` when no body is.
     fn sliding(
         &mut self,
         bodies: &[Body],
@@ -263,13 +267,23 @@ impl ContactSolver {
             };
             let along = (load - n * load.dot(&n)).norm();
             let capacity = mu[b] * load.dot(&n).abs();
-            if along > capacity * (1.0 + 1e-9)
+            // At μ N to within EDGE it is at the edge of sliding (told so, not "slides").
+            if along > 1e-9 * load.norm()
+                && along >= capacity * (1.0 - EDGE)
                 && worst.is_none_or(|(_, a, c)| along - capacity > a - c)
             {
                 worst = Some((b, along, capacity));
             }
         }
         let (b, load, capacity) = worst?;
+        if load <= capacity * (1.0 + EDGE) {
+            return Some(ContactError::EdgeOfSliding {
+                step,
+                body: bodies[b].name.clone(),
+                load,
+                capacity,
+            });
+        }
         Some(ContactError::Sliding {
             step,
             body: bodies[b].name.clone(),

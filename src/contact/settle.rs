@@ -84,16 +84,15 @@ impl ContactSolver {
         obstacles: &[Obstacle],
         settings: ContactSettings,
     ) -> Result<Self, ContactError> {
-        ContactSolver::build(bodies, obstacles, settings, false)
+        ContactSolver::build(bodies, obstacles, settings)
     }
 
-    /// [`ContactSolver::new`], for bodies with inertia (`with_inertia`: they need no
-    /// supports) or without.
+    /// [`ContactSolver::new`] with the settings as given (a dynamic world's too). A body needs
+    /// no supports: its inertia or its contacts may hold it.
     pub(crate) fn build(
         bodies: &[Body],
         obstacles: &[Obstacle],
         settings: ContactSettings,
-        with_inertia: bool,
     ) -> Result<Self, ContactError> {
         let t = Instant::now();
         one_dimension(bodies)?;
@@ -101,12 +100,9 @@ impl ContactSolver {
         let mut node_offsets = Vec::with_capacity(bodies.len());
         let mut nodes = 0;
         for body in bodies {
-            if with_inertia {
-                body.validate_moving()
-            } else {
-                body.validate()
-            }
-            .map_err(SolveError::from)?;
+            // Inertia or the contacts may hold a body without supports (where nothing does,
+            // the settle loop names the motions left free).
+            body.validate_touching().map_err(SolveError::from)?;
             if let PathMethod::ArcLength { .. } = body.newton.path {
                 return Err(ContactError::ArcLength {
                     body: body.name.clone(),
@@ -342,6 +338,13 @@ impl ContactSolver {
                     if let Some(m) = self.mechanism.take() {
                         return Err(ContactError::Mechanism { step, mechanism: m });
                     }
+                    // A body touching surfaces that leave it free to move along them: say
+                    // which motions are free (and whether its loads push it along one).
+                    if let Some(free) =
+                        self.free_body(bodies, &found, (&forces, &offsets), (t, steps), step, false)
+                    {
+                        return Err(free);
+                    }
                     return Err(ContactError::Unsupported {
                         step,
                         body: bodies
@@ -376,8 +379,18 @@ impl ContactSolver {
             seen.push(set);
             set = found;
         }
+        // A body without supports that its contacts leave free to move (the condensed path
+        // settles it where its loads balance along the free motions): named, not solved.
         self.active = set;
         self.expand_condensed();
+        if inertia.is_none() {
+            let set = &self.active;
+            if let Some(free) =
+                self.free_body(bodies, set, (&forces, &offsets), (t, steps), step, true)
+            {
+                return Err(free);
+            }
+        }
         Ok(out)
     }
 

@@ -71,7 +71,6 @@ impl ContactSolver {
                 condense: false,
                 ..settings
             },
-            true,
         )
     }
 

@@ -348,6 +348,12 @@ impl Body {
         self.validate_held(false)
     }
 
+    /// [`Body::validate`] for a body in a scene with contact: its contacts may hold it, so it
+    /// needs no supports (where nothing holds it, the contact solver names the free motions).
+    pub fn validate_touching(&self) -> Result<(), BodyError> {
+        self.validate_held(false)
+    }
+
     /// The checks of [`Body::validate`]; supports are required when `needs_supports`.
     fn validate_held(&self, needs_supports: bool) -> Result<(), BodyError> {
         let body = || self.name.clone();

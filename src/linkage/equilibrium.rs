@@ -127,6 +127,10 @@ pub enum SolveError {
         member: usize,
         /// The breaks of that step, the last one included.
         breaks: Vec<crate::linkage::fracture::BreakEvent>,
+        /// The state it collapsed in, when known: the displacements at the load of the last
+        /// event (just before it) with every member broken so far, the event's included,
+        /// broken (no equilibrium: the structure is a mechanism there).
+        state: Option<Box<StepState>>,
     },
     /// A softening member's fracture energy is less than it dissipates breaking brittle.
     #[error("body '{body}': member {}: softening.fracture_energy = {fracture_energy} J/m² is below the {least:e} J/m² the member dissipates breaking at once (f_t² L/(2E), length {length} m): raise fracture_energy above it, or use teeth = 1 (brittle)", .member + 1)]

@@ -486,6 +486,7 @@ mod tests {
                             broken: if k >= 2 { vec![2] } else { vec![] },
                             breaks: vec![],
                             fallen: vec![],
+                            collapse: false,
                         }),
                     }],
                 }

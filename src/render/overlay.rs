@@ -72,6 +72,9 @@ pub struct Caption {
     pub overloaded: usize,
     /// Broken members so far (`None`: nothing in the run can break).
     pub broken: Option<usize>,
+    /// Whether the step is the state a structure collapsed in (the run's last: its title
+    /// says so).
+    pub collapse: bool,
     /// The member stress of largest magnitude at this step, Pa, and its ratio to that
     /// member's strength when it has one.
     pub peak_stress: Option<(Real, Option<Real>)>,
@@ -119,7 +122,7 @@ fn fmt_number(v: Real) -> String {
 
 /// The caption's title line: the scene, then `t = 1.20 ms, shown 10× slower  ·  frame k of n`
 /// for a dynamic run (the GIF's pace when it has one, see [`pace_label`]), else the step and
-/// its load factor.
+/// its load factor, and "collapsed" on the state a structure collapsed in.
 pub fn title(c: &Caption) -> String {
     match c.time {
         Some(t) => {
@@ -135,12 +138,13 @@ pub fn title(c: &Caption) -> String {
             )
         }
         None => format!(
-            "{}  ·  step {} of {}  ·  {} {}",
+            "{}  ·  step {} of {}  ·  {} {}{}",
             c.scene,
             c.step,
             c.last_step,
             c.load_name,
-            fmt_load(c.load_factor)
+            fmt_load(c.load_factor),
+            if c.collapse { "  ·  collapsed" } else { "" }
         ),
     }
 }
@@ -485,6 +489,7 @@ mod tests {
             max_displacement: 0.0,
             overloaded: 0,
             broken: None,
+            collapse: false,
             peak_stress: None,
             magnification: 1.0,
             shared_by: None,
@@ -516,6 +521,18 @@ mod tests {
         assert_eq!(
             title(&caption(None, None)),
             "drop  ·  step 3 of 60  ·  load factor 0.05"
+        );
+    }
+
+    #[test]
+    fn a_collapse_frame_title_says_collapsed() {
+        let c = Caption {
+            collapse: true,
+            ..caption(None, None)
+        };
+        assert_eq!(
+            title(&c),
+            "drop  ·  step 3 of 60  ·  load factor 0.05  ·  collapsed"
         );
     }
 }

@@ -211,6 +211,10 @@ pub fn draw_frame(
             overloaded: facts.overloaded,
             broken: (facts.broken > 0 || step.bodies.iter().any(|b| b.fracture.is_some()))
                 .then_some(facts.broken),
+            collapse: step
+                .bodies
+                .iter()
+                .any(|b| b.fracture.as_ref().is_some_and(|f| f.collapse)),
             peak_stress: facts.peak,
             magnification: extent.magnification,
             shared_by: extent.shared_by,

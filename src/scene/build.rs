@@ -344,8 +344,13 @@ fn build_world_from(
                 ),
             ));
         }
+        // Inertia (a dynamic scene) or contact (obstacles, a [contact] table) may hold a
+        // body without supports.
         let valid = match dynamics {
             Some(_) => body.validate_moving(),
+            None if !spec.obstacles.is_empty() || spec.contact.is_some() => {
+                body.validate_touching()
+            }
             None => body.validate(),
         };
         valid.map_err(|e| {

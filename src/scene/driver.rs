@@ -237,9 +237,23 @@ fn solve_steps(
             Err(_) if stop.is_raised() => return Err(interrupted(step)),
             // A collapse is a result: the summary records it and the run ends there, published
             // as a complete run.
-            Err(RunError::Collapse { collapse, breaks }) if step > 0 => {
+            Err(RunError::Collapse {
+                collapse,
+                breaks,
+                written,
+            }) if step > 0 => {
                 summary.breaks.extend(breaks);
                 summary.collapse = Some(collapse);
+                // The state it collapsed in, when known, is the run's last stored step
+                // (whatever the [output] stride: it is where the run ends).
+                if let Some(written) = written {
+                    let (result, mut line) = *written;
+                    line.seconds = t.elapsed().as_secs_f64() + if step == 1 { setup } else { 0.0 };
+                    (line.peak_stress, line.stress_ratio) = peak_stress(&result, Some(world));
+                    summary.steps.push(line);
+                    store(result);
+                    on_step();
+                }
                 break;
             }
             // A step after step 0 that cannot be solved ends the run, but the steps before it

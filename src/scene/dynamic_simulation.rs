@@ -306,6 +306,7 @@ impl<'w> DynamicSimulation<'w> {
                             })
                             .collect(),
                         fallen: Vec::new(),
+                        collapse: false,
                     });
                 }
             }

@@ -102,6 +102,11 @@ pub struct BodyFracture {
     /// from the solve; absent when none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub fallen: Vec<usize>,
+    /// The body collapsed in this step: the state written is the one it collapsed in (the
+    /// displacements at its last break, every member broken so far shown broken; no
+    /// equilibrium), the run's last step. Absent otherwise.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub collapse: bool,
 }
 
 /// A break as the summary lists it.
@@ -127,7 +132,9 @@ pub struct SummaryBreak {
 /// The collapse of a structure: a break left its supported part a mechanism.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Collapse {
-    /// The step in which it collapsed (not written: it has no equilibrium).
+    /// The step in which it collapsed: written as the run's last step, flagged, when the state
+    /// it collapsed in is known (a body solved on its own with linear kinematics); not
+    /// written otherwise (it has no equilibrium).
     pub step: usize,
     /// Body name.
     pub body: String,
@@ -268,6 +275,10 @@ pub struct StepSummary {
     /// `time`, the energies and the momenta of a dynamic scene (absent otherwise).
     #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
     pub dynamics: Option<StepEnergy>,
+    /// This line is the state a structure collapsed in (see [`BodyFracture::collapse`]): at
+    /// the load factor of its last break, the run's last step. Absent otherwise.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub collapse: bool,
 }
 
 /// Size of one body, as reported in `summary.json`.

@@ -41,13 +41,17 @@ pub enum RunError {
         source: Box<RunError>,
     },
     /// A break made a structure a mechanism: a result, not a failure. The driver records it
-    /// in the summary and ends the run there with the steps before it written.
+    /// in the summary and ends the run there with the steps before it written, and the
+    /// collapse step itself when its state is known (`written`).
     #[error("body '{}' collapsed at step {} (load factor {}): breaking member {} left its supported part a mechanism", .collapse.body, .collapse.step, .collapse.load_factor, .collapse.member)]
     Collapse {
         /// The collapse.
         collapse: crate::scene::results::Collapse,
         /// The breaks of the collapse step, the last one included.
         breaks: Vec<crate::scene::results::SummaryBreak>,
+        /// The collapse step as written, when the state it collapsed in is known: the run's
+        /// last stored step, flagged `collapse`.
+        written: Option<Box<(crate::scene::StepResult, crate::scene::StepSummary)>>,
     },
     /// The run was asked to stop (SIGINT, SIGTERM) before it finished; nothing was written.
     #[error("{scene}: interrupted at step {step}: no results written (earlier results of the scene are untouched)")]

@@ -50,6 +50,9 @@ pub struct Simulation<'w> {
     /// Per body, in a scene solved body by body, the watch for its self-contact (breaking
     /// bodies with self-contact on); empty once on the contact solver.
     self_watch: Vec<Option<SelfContactWatch>>,
+    /// A body's collapse in the step being solved body by body, whose state is known: the
+    /// step is written with it and then the collapse returned ([`RunError::Collapse`]).
+    collapsed: Option<RunError>,
 }
 
 impl<'w> Simulation<'w> {
@@ -134,6 +137,7 @@ impl<'w> Simulation<'w> {
             capacity: CapacityWatch::default(),
             fracture,
             self_watch,
+            collapsed: None,
         })
     }
 
@@ -222,6 +226,25 @@ impl<'w> Simulation<'w> {
         summary
             .warnings
             .extend(self.slip_warnings(step, &states, &contacts));
+        if let Some(RunError::Collapse {
+            collapse, breaks, ..
+        }) = self.collapsed.take()
+        {
+            // The state the structure collapsed in: written as the run's last step, flagged.
+            summary.collapse = true;
+            for b in &mut result.bodies {
+                if b.name == collapse.body {
+                    if let Some(f) = b.fracture.as_mut() {
+                        f.collapse = true;
+                    }
+                }
+            }
+            return Err(RunError::Collapse {
+                collapse,
+                breaks,
+                written: Some(Box::new((result, summary))),
+            });
+        }
         Ok((result, summary))
     }
 
@@ -355,6 +378,7 @@ impl<'w> Simulation<'w> {
             return Ok(Ok(Vec::new()));
         };
         let mut states = Vec::with_capacity(solvers.len());
+        let mut collapsed = None;
         for (body, solver) in world.bodies.iter().zip(solvers.iter_mut()) {
             let state = match solver.solve_step(body, step, world.steps) {
                 Ok(state) => state,
@@ -363,8 +387,17 @@ impl<'w> Simulation<'w> {
                     step,
                     member,
                     breaks,
+                    state,
                 }) => {
-                    return Err(self.collapse(&body, step, member, &breaks));
+                    // With its state known, the step is written with it (the other bodies
+                    // solved too); the first collapse is the run's.
+                    match state {
+                        Some(state) if collapsed.is_none() => {
+                            collapsed = Some((body, step, member, breaks));
+                            *state
+                        }
+                        _ => return Err(self.collapse(&body, step, member, &breaks)),
+                    }
                 }
                 Err(source) => {
                     return Err(RunError::Solve {
@@ -375,6 +408,10 @@ impl<'w> Simulation<'w> {
             };
             add_newton_counts(summary, &state);
             states.push(state);
+        }
+        if let Some((body, step, member, breaks)) = collapsed {
+            self.collapsed = Some(self.collapse(&body, step, member, &breaks));
+            return Ok(Ok(states));
         }
         for (b, state) in states.iter().enumerate() {
             let Some(watch) = self.self_watch.get_mut(b).and_then(Option::as_mut) else {
@@ -509,6 +546,7 @@ impl<'w> Simulation<'w> {
                     time: None,
                 })
                 .collect(),
+            written: None,
         }
     }
 
@@ -541,6 +579,7 @@ impl<'w> Simulation<'w> {
             broken: fracture.broken.iter().map(|m| m + 1).collect(),
             breaks: self.break_records(&fracture.breaks, step),
             fallen,
+            collapse: false,
         }
     }
 
@@ -665,6 +704,7 @@ pub(crate) fn empty_summary(step: usize, load_factor: Real) -> StepSummary {
         peak_stress: None,
         stress_ratio: None,
         dynamics: None,
+        collapse: false,
     }
 }
 

@@ -109,6 +109,9 @@ pub struct BreakingEquilibrium {
     broken: Vec<usize>,
     /// Per member, whether it broke in tension (its ends apart at the break).
     in_tension: Vec<bool>,
+    /// The step being broken and the largest fraction of its load increment its events
+    /// reached: the load of a collapse state.
+    reached: (usize, Real),
     /// Per node, whether it fell off with a piece.
     fallen_node: Vec<bool>,
     supported_node: Vec<bool>,
@@ -166,6 +169,7 @@ impl BreakingEquilibrium {
             patterns: Vec::new(),
             broken: Vec::new(),
             in_tension: vec![false; body.members.len()],
+            reached: (0, 0.0),
             fallen_node: vec![false; body.nodes.len()],
             supported_node,
         };
@@ -620,6 +624,7 @@ impl BreakingEquilibrium {
         fallen: &mut Vec<FallenPiece>,
     ) -> Result<Vec<BreakEvent>, SolveError> {
         if step == 0 {
+            self.reached = (0, 0.0);
             return Ok(Vec::new());
         }
         let factors = |s: usize| -> Vec<Real> {
@@ -630,6 +635,14 @@ impl BreakingEquilibrium {
         };
         let (f0, f1) = (factors(step - 1), factors(step));
         let mut events = self.next_breaks(body, &f0, &f1);
+        // The load the step reached: a cascade's later breaks may be reported at a lower load
+        // (where the weakened structure would have broken), but the load does not go back.
+        if self.reached.0 != step {
+            self.reached = (step, 0.0);
+        }
+        if let Some(e) = events.first() {
+            self.reached.1 = self.reached.1.max(e.fraction);
+        }
         // Each member's elongation at its break, before the removals change the patterns.
         for event in &events {
             let t = event.fraction;
@@ -642,6 +655,12 @@ impl BreakingEquilibrium {
             self.in_tension[event.member] = elongation > 0.0;
         }
         let members: Vec<usize> = events.iter().map(|e| e.member).collect();
+        // The state at the event, before the removals change the patterns: the collapse
+        // state should the event be the structure's collapse.
+        let t = self.reached.1;
+        let at_event: Vec<Real> = f0.iter().zip(&f1).map(|(a, b)| a + t * (b - a)).collect();
+        let u = self.combine(&at_event, |p| &p.displacements);
+        let forces = self.combine(&at_event, |p| &p.forces);
         match self.break_members(body, &members) {
             Ok((teeth, pieces)) => {
                 fallen.extend(pieces);
@@ -650,12 +669,31 @@ impl BreakingEquilibrium {
                 }
                 Ok(events)
             }
-            Err(member) => Err(SolveError::Collapse {
-                body: body.name.clone(),
-                step,
-                member,
-                breaks: events,
-            }),
+            Err(member) => {
+                // Brittle members of the event break (the removals may have stopped before
+                // them); a softening one keeps its tooth.
+                let mut broken = self.broken.clone();
+                for &m in &members {
+                    if self.teeth[m].is_empty() && !broken.contains(&m) {
+                        broken.push(m);
+                        self.stiffness[m] = 0.0;
+                    }
+                }
+                let (mut state, _) = self.state_of(body, &u, &forces);
+                state.iterations = 1;
+                state.fracture = Some(FractureState {
+                    broken,
+                    breaks: events.clone(),
+                    fallen: Vec::new(),
+                });
+                Err(SolveError::Collapse {
+                    body: body.name.clone(),
+                    step,
+                    member,
+                    breaks: events,
+                    state: Some(Box::new(state)),
+                })
+            }
         }
     }
 
@@ -685,13 +723,21 @@ impl BreakingEquilibrium {
                     step,
                     member,
                     breaks,
+                    mut state,
                 }) => {
                     fracture.breaks.extend(breaks);
+                    // The collapse state lists every break of the step and the pieces that
+                    // fell off in it.
+                    if let Some(f) = state.as_mut().and_then(|s| s.fracture.as_mut()) {
+                        f.breaks = fracture.breaks.clone();
+                        f.fallen = std::mem::take(&mut fracture.fallen);
+                    }
                     return Err(SolveError::Collapse {
                         body,
                         step,
                         member,
                         breaks: fracture.breaks,
+                        state,
                     });
                 }
                 Err(e) => return Err(e),
@@ -703,22 +749,9 @@ impl BreakingEquilibrium {
             .iter()
             .map(|p| p.schedule.factor(step, steps))
             .collect();
-        let d = self.dofs.dofs_per_node;
         let u = self.combine(&factors, |p| &p.displacements);
         let forces = self.combine(&factors, |p| &p.forces);
-        let mut internal = vec![0.0; u.len()];
-        linear_internal_forces(body, &self.stiffness, &u, &mut internal);
-        let members = body.members.iter().enumerate().map(|(m, member)| {
-            let strain = linear_stretch(&u, d, member.nodes, &self.axes[m]) / body.member_length(m);
-            let material = &body.materials[member.material];
-            let force = if self.stiffness[m] > 0.0 {
-                material.youngs_modulus * self.modulus_factor[m] * strain * material.area
-            } else {
-                0.0
-            };
-            (strain, force)
-        });
-        let mut state = post_process(body, &self.dofs, &u, &forces, &internal, members);
+        let (mut state, internal) = self.state_of(body, &u, &forces);
         state.iterations = usize::from(step > 0);
         state.fracture = Some(fracture);
         // Once a body has split, its parts may carry next to nothing (each moved rigidly by
@@ -736,6 +769,26 @@ impl BreakingEquilibrium {
             });
         }
         Ok(state)
+    }
+
+    /// The state of the members as they are now at displacements `u` and loads `forces`
+    /// (per body DOF; N), and the internal forces (per body DOF; N).
+    fn state_of(&self, body: &Body, u: &[Real], forces: &[Real]) -> (StepState, Vec<Real>) {
+        let d = self.dofs.dofs_per_node;
+        let mut internal = vec![0.0; u.len()];
+        linear_internal_forces(body, &self.stiffness, u, &mut internal);
+        let members = body.members.iter().enumerate().map(|(m, member)| {
+            let strain = linear_stretch(u, d, member.nodes, &self.axes[m]) / body.member_length(m);
+            let material = &body.materials[member.material];
+            let force = if self.stiffness[m] > 0.0 {
+                material.youngs_modulus * self.modulus_factor[m] * strain * material.area
+            } else {
+                0.0
+            };
+            (strain, force)
+        });
+        let state = post_process(body, &self.dofs, u, forces, &internal, members);
+        (state, internal)
     }
 }
 

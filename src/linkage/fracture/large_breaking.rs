@@ -274,6 +274,7 @@ impl LargeBreakingEquilibrium {
                         step,
                         member: members.first().copied().unwrap_or(0),
                         breaks: events.clone(),
+                        state: None,
                     });
                 }
             }
@@ -290,6 +291,7 @@ impl LargeBreakingEquilibrium {
                 step,
                 member: last.member,
                 breaks: events.to_vec(),
+                state: None,
             },
             _ => e,
         }
