@@ -769,6 +769,25 @@ fn a_pressure_on_a_body_with_a_tension_only_post_is_carried_by_the_rest() {
     assert_close("elastic", elastic.u(0, 1)[1], 1000.0 / (kd() + EA), 1e-9);
 }
 
+/// The load factor of a scene whose only load is a pressure is the pressure's schedule
+/// (`[0.5, 0.5, 1.0]`: 0.5 at step 2, not the step fraction 2/3), and the displacement follows
+/// it (u_y = 0.5 P/(K_d + E A) at step 2, 1e-9); a load on another schedule beside it makes the
+/// load factor the step fraction.
+#[test]
+fn the_load_factor_of_a_scene_loaded_by_a_pressure_alone_is_its_schedule() {
+    let p =
+        "[[bodies.pressures]]\nnodes = [1, 2, 4]\npressure = 1000.0\nschedule = [0.5, 0.5, 1.0]\n";
+    let r = run(&vee(3, "", "", "", "", p), &vee_files());
+    let factors: Vec<f64> = r.summary.steps.iter().map(|s| s.load_factor).collect();
+    assert_eq!(factors, [0.0, 0.5, 0.5, 1.0]);
+    let uy = r.steps[2].bodies[0].displacements[0][1];
+    assert_close("u_y at step 2", uy, 500.0 / (kd() + EA), 1e-9);
+    let both = format!("{p}{}", load_at_1(10.0));
+    let r = run(&vee(3, "", "", "", "", &both), &vee_files());
+    let factors: Vec<f64> = r.summary.steps.iter().map(|s| s.load_factor).collect();
+    assert_eq!(factors, [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0]);
+}
+
 /// NL × G: a chain of tension-only members hanging under its own weight (the closed form of
 /// `assert_hanging_chain`).
 #[test]

@@ -105,8 +105,8 @@ impl World {
         !self.obstacles.is_empty() || self.contact_table
     }
 
-    /// The load factor reported for `step`: the common schedule's factor when every load and
-    /// prescribed displacement of the scene follows one schedule ([`common_schedule`]), else
+    /// The load factor reported for `step`: the common schedule's factor when every load,
+    /// pressure and prescribed displacement of the scene follows one schedule ([`common_schedule`]), else
     /// `step / steps` (the step fraction).
     pub fn load_factor(&self, step: usize) -> Real {
         common_schedule(&self.bodies)
@@ -145,17 +145,22 @@ impl World {
     }
 }
 
-/// The one schedule every load and prescribed displacement of `bodies` follows; `None` when
-/// they follow different ones or there is none: the results' load factor is then the step
-/// fraction (`step / steps`, or `t / duration` in time), which pictures and plots call so.
+/// The one schedule every load, pressure and prescribed displacement of `bodies` follows;
+/// `None` when they follow different ones or there is none: the results' load factor is then
+/// the step fraction (`step / steps`, or `t / duration` in time), which pictures and plots call
+/// so.
 pub fn common_schedule(bodies: &[Body]) -> Option<&Schedule> {
     let mut schedules = bodies.iter().flat_map(|b| {
-        b.loads.iter().map(|l| &l.schedule).chain(
-            b.supports
-                .iter()
-                .filter(|s| s.displacement.norm() > 0.0)
-                .map(|s| &s.schedule),
-        )
+        b.loads
+            .iter()
+            .map(|l| &l.schedule)
+            .chain(b.pressures.iter().map(|p| &p.schedule))
+            .chain(
+                b.supports
+                    .iter()
+                    .filter(|s| s.displacement.norm() > 0.0)
+                    .map(|s| &s.schedule),
+            )
     });
     let first = schedules.next()?;
     schedules.all(|s| s == first).then_some(first)
