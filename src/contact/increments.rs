@@ -194,7 +194,7 @@ impl ContactSolver {
     /// The problem of the current state with `set`, `forces` (N per body DOF; following
     /// pressures at pseudo-time `time`) and the obstacles at `offsets` (m), for `step`: the
     /// contact Newton's limits and friction's history.
-    fn problem<'a>(
+    pub(crate) fn problem<'a>(
         &'a self,
         bodies: &'a [Body],
         set: &'a ContactSet,

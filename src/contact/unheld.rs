@@ -3,7 +3,6 @@
 use crate::contact::body_part::position;
 use crate::contact::evaluate::friction_key;
 use crate::contact::free_motions::{FreeMotions, Held};
-use crate::contact::problem::{newton_limits, Problem};
 use crate::contact::{ContactError, ContactSet, ContactSolver};
 use crate::linkage::body_state::node_vector;
 use crate::linkage::Body;
@@ -29,22 +28,21 @@ impl ContactSolver {
         step: usize,
         settled: bool,
     ) -> Option<ContactError> {
-        let (tolerance, max_iterations) = newton_limits(bodies);
-        let problem = Problem {
-            bodies,
-            geometry: &self.geometry,
-            set: found,
-            forces,
-            time,
-            offsets,
-            step,
-            tolerance,
-            max_iterations,
-            move_cap: self.move_cap,
-            force_floor: self.force_floor(),
-            friction: self.friction.as_ref(),
-            inertia: None,
+        // At a settled state only a loaded body without any support is judged: most scenes
+        // have none, and then the contacts are not evaluated again.
+        let unsupported = |b: usize, body: &Body| {
+            body.supports.iter().all(|s| !s.fixed.iter().any(|f| *f))
+                && forces[b].iter().any(|f| *f != 0.0)
         };
+        if settled
+            && !bodies
+                .iter()
+                .enumerate()
+                .any(|(b, body)| unsupported(b, body))
+        {
+            return None;
+        }
+        let problem = self.problem(bodies, found, (forces, time), offsets, step);
         let mut normals = self.normals.clone();
         let evaluated = problem.evaluate(&mut normals, &self.parts);
         let mut held: Vec<Vec<Held>> = vec![Vec::new(); bodies.len()];
@@ -71,19 +69,18 @@ impl ContactSolver {
             }
         }
         for (b, body) in bodies.iter().enumerate() {
-            let d = self.parts[b].dofs.dofs_per_node;
-            let load: Vector3<Real> = (0..body.nodes.len())
-                .map(|n| node_vector(&forces[b], d, n))
-                .sum();
             let judged = if settled {
-                body.supports.iter().all(|s| !s.fixed.iter().any(|f| *f))
-                    && forces[b].iter().any(|f| *f != 0.0)
+                unsupported(b, body)
             } else {
                 touching[b]
             };
             if !judged {
                 continue;
             }
+            let d = self.parts[b].dofs.dofs_per_node;
+            let load: Vector3<Real> = (0..body.nodes.len())
+                .map(|n| node_vector(&forces[b], d, n))
+                .sum();
             let nodes: Vec<Vector3<Real>> = (0..body.nodes.len())
                 .map(|n| position(bodies, &self.parts, b, n))
                 .collect();
