@@ -4,7 +4,7 @@ use crate::contact::body_part::{largest_nodal_move, BodyPart};
 use crate::contact::coupled_iterative::CoupledIterative;
 use crate::contact::coupled_system::CoupledSystem;
 use crate::contact::evaluate::{Evaluated, Evaluation};
-use crate::contact::problem::{Problem, STABILISATION};
+use crate::contact::problem::{Problem, LOADED_RIGID_MOTION, STABILISATION};
 use crate::contact::{ActiveContact, ContactError, ContactSet};
 use crate::linalg::{CholeskyError, LowRankCorrection, SparseColumn};
 use crate::linkage::body_state::{fill_tangent, internal_force_vector, norm};
@@ -288,6 +288,12 @@ impl CoupledSolver {
                 pending = last;
             } else {
                 self.move_free(parts, &base, &delta, s);
+                if stabilised && rnorm > LOADED_RIGID_MOTION * scale {
+                    // A loaded rigid motion that no contact of this set holds (a body resting
+                    // on a surface at a depth of round-off): moving it cannot reduce the
+                    // residual with the set fixed. Look for contacts again.
+                    return Ok((iterations, false));
+                }
             }
             last_step = s * norm(&delta);
         }

@@ -215,6 +215,7 @@ impl ContactSolver {
             max_iterations,
             move_cap: self.move_cap,
             force_floor: self.force_floor(),
+            round_off: self.round_off(set),
             friction: self.friction.as_ref(),
             inertia: None,
         }

@@ -5,7 +5,9 @@ use crate::contact::condensed::CondensedSolver;
 use crate::contact::coupled::CoupledSolver;
 use crate::contact::coupled_iterative::CoupledIterative;
 use crate::contact::detect::{candidate_nodes, Geometry};
-use crate::contact::problem::{interrupted, newton_limits, Problem, FORCE_FLOOR};
+use crate::contact::problem::{
+    interrupted, newton_limits, round_off_residual, Problem, FORCE_FLOOR,
+};
 use crate::contact::report::{finish, ContactStep};
 use crate::contact::start::{no_start_overlap, one_dimension};
 use crate::contact::{
@@ -74,6 +76,8 @@ pub struct ContactSolver {
     /// steps' residuals, so a body whose forces vanish (split, unloaded) is not measured
     /// against round-off.
     pub(crate) largest_force_scale: Real,
+    /// The largest coordinate of a node, m (see [`round_off_residual`]).
+    pub(crate) extent: Real,
 }
 
 impl ContactSolver {
@@ -209,6 +213,11 @@ impl ContactSolver {
             query_seconds: 0.0,
             removed: Vec::new(),
             largest_force_scale: 0.0,
+            extent: bodies
+                .iter()
+                .flat_map(|b| &b.nodes)
+                .map(|x| x.amax())
+                .fold(0.0, Real::max),
         })
     }
 
@@ -244,6 +253,17 @@ impl ContactSolver {
         } else {
             0.0
         }
+    }
+
+    /// The out-of-balance the coordinates' round-off leaves in the penalties of `set`, N:
+    /// a Newton stalled below it has converged (see [`round_off_residual`]).
+    pub(crate) fn round_off(&self, set: &ContactSet) -> Real {
+        let penalty = self
+            .parts
+            .iter()
+            .map(|p| p.penalty.stiffness)
+            .fold(0.0, Real::max);
+        round_off_residual(self.extent, penalty, set.len())
     }
 
     /// Rows of the coupled system of all bodies (their free DOFs).
@@ -439,6 +459,7 @@ impl ContactSolver {
             } else {
                 self.largest_force_scale
             }),
+            round_off: self.round_off(&self.active),
             friction: self.friction.as_ref(),
             inertia,
         };
@@ -491,6 +512,7 @@ impl ContactSolver {
             max_iterations,
             move_cap: self.move_cap,
             force_floor: self.force_floor(),
+            round_off: self.round_off(set),
             friction: self.friction.as_ref(),
             inertia,
         };

@@ -64,10 +64,14 @@ impl Convergence {
     /// iterations only stir round-off; seen: 1.79e-10 held for 30 iterations when faer's
     /// parallel rounding fell that way against a tolerance of 1e-10).
     pub fn stalled(&self) -> bool {
+        self.stalled_within(STALL_TOLERANCES * self.tolerance)
+    }
+
+    /// Whether the iteration has stalled at or below the relative residual `bound`: at least
+    /// three residuals, the last at most `bound` and no longer below half the one before it.
+    pub fn stalled_within(&self, bound: Real) -> bool {
         let n = self.history.len();
-        n >= 3
-            && self.history[n - 1] <= STALL_TOLERANCES * self.tolerance
-            && self.history[n - 1] >= 0.5 * self.history[n - 2]
+        n >= 3 && self.history[n - 1] <= bound && self.history[n - 1] >= 0.5 * self.history[n - 2]
     }
 
     /// Whether the last residual fell below a tenth of the one before (fast convergence: a

@@ -217,6 +217,10 @@ impl CondensedBody {
         for a in 0..basis.len() {
             for b in 0..basis.len() {
                 let h: Real = basis[a].iter().zip(&z[b]).map(|(x, y)| x * y).sum();
+                // `− Z_C Q_Cᵀ − Q_C Z_Cᵀ` pairs each rigid motion with its own `K⁻¹ q`: only
+                // where a = b (with every pair, the compliance lost its symmetry's meaning
+                // and became indefinite for more than one free rigid motion).
+                let own = if a == b { 1.0 } else { 0.0 };
                 let (za, qa, zb, qb) = (&zc[a], &qc[a], &zc[b], &qc[b]);
                 // Columns side by side: the last body to finish its set-up runs this alone.
                 compliance
@@ -224,7 +228,7 @@ impl CondensedBody {
                     .enumerate()
                     .for_each(|(j, column)| {
                         for (i, c) in column.iter_mut().enumerate() {
-                            *c += -za[i] * qb[j] - qa[i] * zb[j] + qa[i] * h * qb[j];
+                            *c += own * (-za[i] * qb[j] - qa[i] * zb[j]) + qa[i] * h * qb[j];
                         }
                     });
             }
