@@ -1,6 +1,6 @@
 //! Contact set-ups that must converge where users put them (issue 32, contact cases 1 and 2).
-//! The test here checks the tilted floor's contact normals; cases 1 and 2 themselves are NOT
-//! fixed yet, and have no test until they are (`block_scene` below writes case 1's block, at
+//! The test here checks the tilted floor's contact normals; case 1 itself is NOT fixed yet,
+//! and has no test until it is (`block_scene` below writes case 1's block, at
 //! any angle, placement and number of steps). What was found:
 //!
 //! Case 1 (a block on a floor tilted 20°, μ = 0.4, its own weight, 2 steps) stalled, and is
@@ -24,15 +24,9 @@
 //!   normal, checked below).
 //!
 //! Case 2 (two balls from `scenes/ball.obj`, the right one pushed by 200 N, held sideways only)
-//! did not fail as set up here (the left ball held at its far cap, the right one on the axes
-//! across the load): it converges with the contact force at 200 N, in 18 Newton iterations;
-//! supports that leave the right ball's rotations free make it a mechanism (case 3). A close
-//! set-up does fail: two balls of
-//! `ball.obj`'s kind, each held at its far cap, the upper pressed 4–10 mm onto the lower by a
-//! prescribed displacement (tests/interrupts.rs's scene, spacing 0.007–0.02 m): from step 3 or
-//! 4 on, at every cut, the relative residual falls to about 3e-8 in one iteration and then
-//! creeps down 3 % per iteration (1.3e-8 after 30), above the stall bound (100 tolerances,
-//! 1e-8), so the step is given up.
+//! and the pressed balls close to it are in tests/contact_balls.rs: the condensed Newton
+//! converged only linearly there (its tangent leaves out the normals' turning), and now mixes
+//! its iterates when it does.
 
 use linkage::linkage::generators::box_lattice;
 use linkage::scene::{load_scene, StepResult, StepSummary};

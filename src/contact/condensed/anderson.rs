@@ -1,4 +1,4 @@
-//! Anderson acceleration of the condensed Newton's iteration with a kept approximate factor (large contact sets with friction).
+//! Anderson acceleration of the condensed Newton's iteration with a kept factor: an approximate one (large contact sets with friction), or an exact one whose frozen-normal tangent converges only linearly (frictionless).
 
 use crate::Real;
 use nalgebra::{DMatrix, DVector};
@@ -6,9 +6,10 @@ use std::collections::VecDeque;
 
 /// Anderson mixing (type II, Walker & Ni 2011) of the fixed-point iteration `x ← x + g(x)`,
 /// where `x` is the condensed state (contact forces at the candidates, N, then rigid
-/// amplitudes, m) and `g(x)` the correction of a kept approximate factor: a chord iteration,
-/// linear at a rate of 0.3–0.5 in a shear (see `FrictionInverse`). From the last `depth`
-/// differences of iterates `Δx` and of corrections `Δg`, the next step is
+/// amplitudes, m) and `g(x)` the correction of a kept factor: a chord iteration, linear at a
+/// rate of 0.3–0.5 in a shear with an approximate factor (see `FrictionInverse`), 0.4–0.97
+/// with the exact frozen-normal one of balls pressed together (see `CHORD_RATE`). From the
+/// last `depth` differences of iterates `Δx` and of corrections `Δg`, the next step is
 ///
 /// `d = g − (ΔX + ΔG) γ`, `γ = argmin ‖g − ΔG γ‖`,
 ///
