@@ -421,6 +421,19 @@ impl Geometry {
         parts: &[BodyPart],
         offsets: &[Vector3<Real>],
     ) -> ContactSet {
+        self.query_keeping(bodies, parts, offsets, &[])
+    }
+
+    /// [`Geometry::query`], with the contacts `kept` (a flipping set's obstacle contacts that
+    /// still press, see `contact::pressing`) in the set too: a node kept counts as inside its
+    /// obstacle, so the sharp points near it are left out as for a node found inside.
+    pub(crate) fn query_keeping(
+        &self,
+        bodies: &[Body],
+        parts: &[BodyPart],
+        offsets: &[Vector3<Real>],
+        kept: &[ActiveContact],
+    ) -> ContactSet {
         // Deformed boundary polygons and their bounding boxes (the broad phase).
         let polygons: Vec<Option<Polygon>> = self
             .surfaces
@@ -545,6 +558,7 @@ impl Geometry {
                 }
             }
         }
+        found.extend_from_slice(kept);
         let sharp = self.sharp_points_inside(bodies, parts, offsets, &polygons, &meshes, &found);
         found.extend(sharp);
         found.extend(self.own.closed_cracks(bodies, parts, min_depth));

@@ -236,7 +236,7 @@ impl ContactSolver {
         let t = step as Real;
         let offsets: Vec<Vector3<Real>> = obstacles.iter().map(|o| o.offset_at(t, steps)).collect();
         // The contacts where the attempt ended (the set it solved last is not kept).
-        let found = self.look(bodies, &self.active.clone(), &offsets);
+        let found = self.look(bodies, &self.active.clone(), &offsets, &[]);
         let history = self.friction.as_ref()?;
         let forces: Vec<Vec<Real>> = bodies.iter().map(|b| loads_at(b, t, steps)).collect();
         let problem = self.problem(bodies, &found, (&forces, (t, steps)), &offsets, step);
@@ -364,13 +364,29 @@ impl ContactSolver {
 
     /// Undo a failed increment; whether the condensed path's state was restored.
     fn restore_keeping(&mut self, saved: Converged) -> bool {
+        // Crossings found in the failed increment belong to a state that is gone.
+        self.geometry.forget_crossings_found();
+        self.restore_state(saved)
+    }
+
+    /// Go back to the state of a set that flipped (`saved` when it first flipped, within the
+    /// same settle: the crossings found so far stay); leave the condensed path unless its
+    /// state was restored.
+    pub(crate) fn restore_flip(&mut self, saved: Converged) -> Result<(), ContactError> {
+        if !self.restore_state(saved) {
+            self.leave_condensed()?;
+        }
+        Ok(())
+    }
+
+    /// Put back the displacements, the contact set, the normals and the condensed path's
+    /// state of `saved`; whether the condensed path's state was restored.
+    fn restore_state(&mut self, saved: Converged) -> bool {
         for (p, u) in self.parts.iter_mut().zip(saved.u) {
             p.u = u;
         }
         self.active = saved.active;
         self.normals = saved.normals;
-        // Crossings found in the failed increment belong to a state that is gone.
-        self.geometry.forget_crossings_found();
         match (self.condensed.as_mut(), saved.condensed) {
             (Some(c), Some(state)) => c.restore(state),
             _ => false,

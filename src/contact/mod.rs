@@ -44,6 +44,7 @@ mod obstacle_features;
 mod obstacles;
 mod patch_surface;
 mod penalty;
+mod pressing;
 mod problem;
 mod report;
 mod self_contact;

@@ -5,6 +5,8 @@ use crate::contact::condensed::CondensedSolver;
 use crate::contact::coupled::CoupledSolver;
 use crate::contact::coupled_iterative::CoupledIterative;
 use crate::contact::detect::{candidate_nodes, Geometry};
+use crate::contact::increments::Converged;
+use crate::contact::pressing::{flip_warning, FLIP_WITHIN};
 use crate::contact::problem::{
     interrupted, newton_limits, round_off_residual, Problem, FORCE_FLOOR,
 };
@@ -31,9 +33,12 @@ use std::time::Instant;
 /// each active contact adding its penalty stiffness `k n nᵀ` (implicit penalty). Then every
 /// node is projected on the obstacles: the nodes inside one form the next set (a node of the
 /// set that came out, pulled by its penalty, leaves it). The step has settled when the set
-/// found is the set solved. A set seen before (the contact flips back and forth) ends the loop
-/// with a warning, as does running out of contact iterations. When every body is linear, the
-/// Newton runs on the contact candidates instead ([`CondensedSolver`]).
+/// found is the set solved. A set seen before (the contact flips back and forth) is settled
+/// again from the union of the sets of the cycle, a contact staying while it still presses
+/// (depth > 0 along its normal, see `contact::pressing`); a set that flips even so fails the
+/// step ([`ContactError::Flips`], retried with a smaller increment first). Running out of
+/// contact iterations ends the loop with a warning. When every body is linear, the Newton runs
+/// on the contact candidates instead ([`CondensedSolver`]).
 pub struct ContactSolver {
     pub(crate) parts: Vec<BodyPart>,
     pub(crate) geometry: Geometry,
@@ -282,15 +287,19 @@ impl ContactSolver {
         self.parts.get(body).map_or(0.0, |p| p.penalty.stiffness)
     }
 
-    /// The contacts of `found` after keeping patches against `solved`, timed as a query.
+    /// The contacts of `found` after keeping patches against `solved`, timed as a query; with
+    /// the contacts `kept` too (see [`Geometry::query_keeping`]).
     pub(crate) fn look(
         &mut self,
         bodies: &[Body],
         solved: &ContactSet,
         offsets: &[Vector3<Real>],
+        kept: &[ActiveContact],
     ) -> ContactSet {
         let t = Instant::now();
-        let mut found = self.geometry.query(bodies, &self.parts, offsets);
+        let mut found = self
+            .geometry
+            .query_keeping(bodies, &self.parts, offsets, kept);
         if !self.removed.is_empty() {
             let removed = &self.removed;
             found.contacts.retain(|c| {
@@ -330,7 +339,11 @@ impl ContactSolver {
         let mut seen: Vec<ContactSet> = Vec::new();
         let mut out = ContactStep::default();
         let mut refinements = 0;
+        // Once the set flipped: the state and set solved then (a contact of the set solved
+        // stays while it still presses from there on).
+        let mut first_flip: Option<(Converged, ContactSet)> = None;
         loop {
+            let pressing = first_flip.is_some();
             if interrupted(bodies) {
                 return Err(ContactError::Interrupted { step });
             }
@@ -339,11 +352,19 @@ impl ContactSolver {
                 self.newton(bodies, &set, (&forces, &offsets), (t, steps), step, inertia)?;
             out.newton_iterations += iterations;
             out.stabilised |= !settled;
-            let mut found = self.look(bodies, &set, &offsets);
+            // Once the set flipped, the contacts of the set solved that still press stay.
+            let mut kept = Vec::new();
+            if pressing {
+                kept = self.still_pressing(bodies, &set, (&forces, &offsets), (t, steps), step);
+            }
+            let mut found = self.look(bodies, &set, &offsets, &kept);
             if settled && found == set && self.condensed.is_some() {
                 // Settled on the candidates: solve for every node, and look again with them.
                 let differs = self.expand_condensed();
-                found = self.look(bodies, &set, &offsets);
+                if pressing {
+                    kept = self.still_pressing(bodies, &set, (&forces, &offsets), (t, steps), step);
+                }
+                found = self.look(bodies, &set, &offsets, &kept);
                 // The placement was off by the compliance's round-off (a penalty turns 1e-13 m
                 // into forces the tolerance sees): above a tenth of the tolerance, Newton again
                 // from the solve, which returns at once when the residual there is within it.
@@ -381,15 +402,69 @@ impl ContactSolver {
                 break;
             }
             if seen.contains(&found) {
+                // Within the tolerance (no node inside beyond it without its force, no contact
+                // pulling beyond it), the set solved has settled.
+                let gap = self.flip_gap(
+                    bodies,
+                    (&set, &found),
+                    (&forces, &offsets),
+                    (t, steps),
+                    step,
+                );
+                if gap <= FLIP_WITHIN {
+                    break;
+                }
+                if let Some((saved, solved)) = first_flip.take() {
+                    // It flips even so: back to the set solved when it first flipped, said.
+                    out.warnings
+                        .push(flip_warning(bodies, step, (&set, &found), gap, None));
+                    self.restore_flip(saved)?;
+                    set = solved;
+                    break;
+                }
+                // The set flips back and forth: nodes that come in without a force go out
+                // with one (a rim node under a flush plate's edge, pushed out sideways from
+                // under it by its own force). When only obstacle contacts come and go, settle
+                // again keeping the obstacle contacts of the set solved that still press (depth
+                // > 0 along their normal); other flips keep the last set solved, said.
                 let (joined, left) = found.difference(&set);
-                out.warnings.push(format!(
-                    "step {step}: the contact set flips back and forth ({} nodes come in and {} go out between iterations): kept the last set solved; use more steps or a larger [contact] penalty",
-                    joined.len(),
-                    left.len()
-                ));
-                break;
+                if !joined
+                    .iter()
+                    .chain(&left)
+                    .all(|c| matches!(c.with, Target::Obstacle(_)))
+                {
+                    out.warnings.push(format!(
+                        "step {step}: the contact set flips back and forth ({} contacts come in and {} go out between iterations, {gap:.2} penetration tolerances from settled): kept the last set solved; use more steps or a larger [contact] penalty",
+                        joined.len(),
+                        left.len()
+                    ));
+                    break;
+                }
+                let kept = self.still_pressing(bodies, &set, (&forces, &offsets), (t, steps), step);
+                let kept = self.look(bodies, &set, &offsets, &kept);
+                if kept == set {
+                    break;
+                }
+                first_flip = Some((self.converged_state(), set.clone()));
+                seen.clear();
+                seen.push(set);
+                set = kept;
+                continue;
             }
             if out.contact_iterations >= self.settings.max_iterations {
+                if let Some((saved, solved)) = first_flip.take() {
+                    let iterations = self.settings.max_iterations;
+                    out.warnings.push(flip_warning(
+                        bodies,
+                        step,
+                        (&set, &found),
+                        0.0,
+                        Some(iterations),
+                    ));
+                    self.restore_flip(saved)?;
+                    set = solved;
+                    break;
+                }
                 out.warnings.push(format!(
                     "step {step}: the contact set did not settle in {} contact iterations: kept the last set solved; use more steps",
                     self.settings.max_iterations
