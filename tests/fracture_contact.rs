@@ -507,11 +507,47 @@ penalty = 1e9
         assert!(close(summary.breaks[2].load_factor, p2 / p, 1e-9));
         assert!(summary.breaks[1].load_factor < summary.breaks[0].load_factor);
     }
-    // Step 0, and without contact the state it collapsed in, flagged (the contact path does not
-    // write that state yet).
-    assert_eq!(with.steps.len(), 1, "step 0 only");
-    assert_eq!(without.steps.len(), 2);
-    assert!(without.steps[1].collapse && !without.steps[0].collapse);
+    // Step 0, then the state it collapsed in, flagged, with contact as without: at the load the
+    // step reached (P₁, the first break's), the truss without its vertical bar (the two side
+    // bars carry P₁/√2 each: node 1 sinks √2 P₁/(E A) = 3.0178 mm), every member
+    // shown broken.
+    let u1 = p1 * 2f64.sqrt() / 2e7;
+    for (summary, name) in [(&with, "three_bar"), (&without, "three_bar_alone")] {
+        assert_eq!(summary.steps.len(), 2, "{:?}", summary.steps);
+        assert!(summary.steps[1].collapse && !summary.steps[0].collapse);
+        assert_eq!(summary.steps[1].step, 1);
+        assert_eq!(summary.steps[1].broken, Some(3));
+        let last = step_json(d, name, 1);
+        assert_eq!(
+            last["load_factor"].as_f64(),
+            Some(summary.steps[1].load_factor)
+        );
+        let body = &last["bodies"][0];
+        assert_eq!(body["collapse"].as_bool(), Some(true), "{body}");
+        let mut broken: Vec<u64> = body["broken"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m.as_u64().unwrap())
+            .collect();
+        broken.sort_unstable();
+        assert_eq!(broken, vec![1, 2, 3]);
+        let forces: Vec<f64> = body["axial_forces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_f64().unwrap())
+            .collect();
+        assert_eq!(forces, vec![0.0; 3]);
+        let uy = body["displacements"][0][1].as_f64().unwrap();
+        assert!(close(uy, -u1, 1e-9), "{name}: {uy} against {}", -u1);
+        assert!(step_json(d, name, 0)["bodies"][0].get("collapse").is_none());
+    }
+    assert_eq!(with.steps[1].load_factor, without.steps[1].load_factor);
+    assert_eq!(
+        with.collapse.as_ref().map(|c| (c.step, c.member)),
+        without.collapse.as_ref().map(|c| (c.step, c.member))
+    );
     for (a, b) in with.breaks.iter().zip(&without.breaks) {
         assert!(close(a.load_factor, b.load_factor, 1e-9), "{a:?} {b:?}");
     }

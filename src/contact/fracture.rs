@@ -47,7 +47,8 @@
 //! removed from the solve: they fell off. Their members carry nothing from then on, their loads
 //! are dropped, their nodes are held where they were made (undeformed) and are no longer looked
 //! for contacts, and contact is settled again. When nothing can be removed, or contact still
-//! cannot be settled, the break is the structure's collapse.
+//! cannot be settled, the break is the structure's collapse; the state it collapsed in is
+//! settled and reported as without contact (see `ContactFracture::collapse_state`).
 
 use crate::contact::{ContactError, ContactSolver, ContactStep, Obstacle, Target};
 use crate::linkage::body_state::{linear_stretch, member_response_at, undeformed_axis};
@@ -92,8 +93,16 @@ pub enum FractureStop {
         member: usize,
         /// The breaks of that body in the step, the last one included.
         breaks: Vec<BreakEvent>,
+        /// The state it collapsed in, when it could be settled (see
+        /// [`ContactFracture::collapse_state`]): the step as reported, every body's fracture
+        /// state with it.
+        state: Option<Box<CollapseState>>,
     },
 }
+
+/// The state a structure collapsed in: the step's report at the load the step reached, and
+/// per body its fracture state (`None` for a body that does not break).
+pub type CollapseState = (ContactStep, Vec<Option<FractureState>>);
 
 impl From<ContactError> for FractureStop {
     fn from(e: ContactError) -> Self {
@@ -406,6 +415,9 @@ impl ContactFracture {
             let (mut t_lo, mut lo) = (end - 1.0, self.last.clone());
             let mut at_end = self.stresses(solver);
             let mut top = (end, at_end.clone());
+            // The load the step reached: a snap-back's later breaks are recorded at a lower
+            // load, but the load does not go back (the load of a collapse state).
+            let mut reached = end - 1.0;
             loop {
                 let over = self.beyond(&at_end);
                 let Some((b, m, t_break)) = self.critical_load(
@@ -423,7 +435,12 @@ impl ContactFracture {
                 // in one event, as without contact.
                 let at_break = self.stresses(solver);
                 let tied = self.tied(b, m, &at_break, &over);
+                reached = reached.max(t_break);
+                // Each member's modulus factor before the event (a collapse state is settled
+                // with them).
+                let mut before = Vec::new();
                 for (b, m) in std::iter::once((b, m)).chain(tied) {
+                    before.push((b, m, self.bodies[b].modulus_factor(m)));
                     let tooth = self.break_member(b, m);
                     events[b].push(BreakEvent {
                         member: m,
@@ -443,10 +460,19 @@ impl ContactFracture {
                         m,
                         &mut fallen[b],
                     )? {
+                        let state = self.collapse_state(
+                            solver,
+                            obstacles,
+                            (step, steps),
+                            (reached, &before),
+                            out,
+                            (&events, &mut fallen),
+                        );
                         return Err(FractureStop::Collapse {
                             body: b,
                             member: m,
                             breaks: std::mem::take(&mut events[b]),
+                            state: state.map(Box::new),
                         });
                     }
                     if t == t_break {
@@ -526,6 +552,59 @@ impl ContactFracture {
         Ok((out, states))
     }
 
+    /// The state a structure collapsed in, as [`BreakingEquilibrium`](crate::linkage::fracture::BreakingEquilibrium)
+    /// writes it without contact: contact settled at the load the step `reached` (pseudo-time:
+    /// its highest break's) on the bodies as they were before the collapse's event (`before`:
+    /// its members, each with its modulus factor then), then reported with every member broken
+    /// so far, the event's included, broken (no equilibrium: the structure is a mechanism
+    /// there). `out` is the step's report to fill; `events` and `fallen` the step's breaks and
+    /// pieces that fell off, per body. `None` when contact cannot be settled there.
+    fn collapse_state(
+        &mut self,
+        solver: &mut ContactSolver,
+        obstacles: &[Obstacle],
+        (step, steps): (usize, usize),
+        (reached, before): (Real, &[(usize, usize, Real)]),
+        out: ContactStep,
+        (events, fallen): (&[Vec<BreakEvent>], &mut [Vec<FallenPiece>]),
+    ) -> Option<CollapseState> {
+        let after: Vec<Real> = before
+            .iter()
+            .map(|&(b, m, _)| self.bodies[b].modulus_factor(m))
+            .collect();
+        for &(b, m, factor) in before {
+            self.bodies[b].member_factors[m] = factor;
+        }
+        let saved = solver.converged_state();
+        let from = self.now;
+        let settled = self.settle(solver, obstacles, reached, (step, steps));
+        if settled.is_err() {
+            solver.restore(saved);
+            self.now = from;
+        }
+        for (&(b, m, _), &factor) in before.iter().zip(&after) {
+            self.bodies[b].member_factors[m] = factor;
+        }
+        settled.ok()?;
+        let report = solver
+            .report_at(&self.bodies, obstacles, (reached, steps), step, None, out)
+            .ok()?;
+        let states = self
+            .breaking
+            .iter()
+            .zip(events)
+            .zip(fallen.iter_mut())
+            .map(|((br, breaks), pieces)| {
+                br.as_ref().map(|br| FractureState {
+                    broken: br.broken.clone(),
+                    breaks: breaks.clone(),
+                    fallen: std::mem::take(pieces),
+                })
+            })
+            .collect();
+        Some((report, states))
+    }
+
     /// Settle at pseudo-time `t` after member `m` of body `b` broke; when contact cannot be
     /// settled, remove the pieces of body `b` that fell off (appended to `fallen`) and settle
     /// again. `false` when that cannot be done: the structure's collapse.
@@ -565,7 +644,14 @@ impl ContactFracture {
                 .into_iter()
                 .map(|nodes| FallenPiece { member: m, nodes }),
         );
-        Ok(self.settle(solver, obstacles, t, steps).is_ok())
+        // A failed settle leaves the state it started from (a collapse state starts there).
+        let saved = solver.converged_state();
+        if self.settle(solver, obstacles, t, steps).is_ok() {
+            return Ok(true);
+        }
+        solver.restore(saved);
+        self.now = from;
+        Ok(false)
     }
 
     /// The pieces of body `b` without support (see [`released_pieces`]) none of whose nodes

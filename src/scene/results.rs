@@ -133,8 +133,8 @@ pub struct SummaryBreak {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Collapse {
     /// The step in which it collapsed: written as the run's last step, flagged, when the state
-    /// it collapsed in is known (a body solved on its own with linear kinematics); not
-    /// written otherwise (it has no equilibrium).
+    /// it collapsed in is known (a body solved on its own with linear kinematics, or any body
+    /// in a scene with contact); not written otherwise (it has no equilibrium).
     pub step: usize,
     /// Body name.
     pub body: String,

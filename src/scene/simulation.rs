@@ -311,6 +311,7 @@ impl<'w> Simulation<'w> {
             scene: world.source.clone(),
             source,
         };
+        let mut collapsed = None;
         let (solved, fractures) = match self.fracture.as_mut() {
             None => (
                 contact
@@ -325,9 +326,18 @@ impl<'w> Simulation<'w> {
                     body,
                     member,
                     breaks,
+                    state,
                 }) => {
                     let name = &world.bodies[body].name;
-                    return Err(self.collapse(name, step, member, &breaks));
+                    // With its state known, the step is written with it, as a body solved on
+                    // its own writes it (see `Simulation::step`).
+                    match state {
+                        Some(state) => {
+                            collapsed = Some((name, member, breaks));
+                            *state
+                        }
+                        None => return Err(self.collapse(name, step, member, &breaks)),
+                    }
                 }
             },
         };
@@ -361,6 +371,9 @@ impl<'w> Simulation<'w> {
                     force: force.as_slice()[..d].to_vec(),
                 });
             }
+        }
+        if let Some((name, member, breaks)) = collapsed {
+            self.collapsed = Some(self.collapse(name, step, member, &breaks));
         }
         Ok((solved.states, solved.contacts))
     }

@@ -25,18 +25,30 @@
 //! members break at the break's load. An elastic body (without friction) has no history but its
 //! broken members, so solving it lower is as good as unloading it.
 //!
-//! A break after which the weakened body cannot be solved at the break's load is its collapse
-//! ([`SolveError::Collapse`]), as a break that leaves the weakened body unable to take the
-//! rest of the step's load is. Pieces are not taken out of the solve here: a piece left without
-//! support makes the tangent singular, which is reported as the collapse at that break.
+//! A break after which the weakened body cannot be solved at the break's load (its tangent is
+//! singular there, as a linear body's stiffness is when something comes loose) leaves pieces
+//! without support (as without contact: connected parts without supports, and nodes on fewer
+//! intact members than their DOFs, see [`released_pieces`]). They are decided as
+//! [`BreakingEquilibrium`](super::BreakingEquilibrium) decides them: a loaded piece still
+//! hanging on the rest by intact members (a mechanism under load: it would swing, not fall),
+//! or a loss that leaves the rest with nothing that loads it, is the structure's collapse
+//! ([`SolveError::Collapse`]); otherwise the pieces fell off and are taken out of the solve
+//! (their members carry nothing, their loads are dropped, their nodes are held where they were
+//! made) and the rest goes on. When nothing came loose, or the rest cannot be solved either,
+//! the break is the collapse, as a break that leaves the weakened body unable to take the rest
+//! of the step's load is. A loaded node left hanging on one member in tension is solved (the
+//! tension holds it sideways under large displacements: a pendulum at rest) and goes on; one
+//! balanced on a strut is solved too, but unstable (a negative pivot): that is the collapse
+//! (with conjugate gradients the pivots are not counted, and it goes on).
 
 use crate::linkage::body_state::member_response_at;
 use crate::linkage::fracture::{
-    critical_fraction, member_limits, member_teeth, strength_ratio, BreakEvent, FractureState,
-    MemberLimits, Tooth, AT_STRENGTH,
+    critical_fraction, member_limits, member_teeth, released_pieces, strength_ratio, BreakEvent,
+    FallenPiece, FractureState, MemberLimits, Tooth, AT_STRENGTH,
 };
 use crate::linkage::SavedNewton;
 use crate::linkage::{Body, NewtonEquilibrium, PathMethod, PhaseTimes, SolveError, StepState};
+use crate::linkage::{PressureFaces, Support};
 use crate::Real;
 
 /// The load search stops when its bracket is narrower than this fraction of a step.
@@ -60,6 +72,8 @@ pub struct LargeBreakingEquilibrium {
     broken: Vec<usize>,
     /// Per member, whether it broke in tension.
     in_tension: Vec<bool>,
+    /// Per node, whether it fell off with a piece.
+    fallen_node: Vec<bool>,
     /// The last step solved.
     step: usize,
     /// Trial Newton solves of the searches so far (each from a saved state).
@@ -104,6 +118,7 @@ impl LargeBreakingEquilibrium {
             tooth: vec![0; n],
             broken: Vec::new(),
             in_tension: vec![false; n],
+            fallen_node: vec![false; body.nodes.len()],
             step: 0,
             trial_solves: 0,
         })
@@ -170,7 +185,12 @@ impl LargeBreakingEquilibrium {
     }
 
     /// Back to the original body, undeformed (step 0).
-    fn start_over(&mut self) {
+    fn start_over(&mut self) -> Result<(), SolveError> {
+        if self.fallen_node.iter().any(|&f| f) {
+            // Its fallen nodes are held: give the solver the whole body back.
+            self.fallen_node.iter_mut().for_each(|f| *f = false);
+            self.newton.refit(&self.original, &[], 0.0)?;
+        }
         self.body = self.original.clone();
         self.limits = self.first_limits.clone();
         self.tooth.iter_mut().for_each(|t| *t = 0);
@@ -178,6 +198,7 @@ impl LargeBreakingEquilibrium {
         self.in_tension.iter_mut().for_each(|t| *t = false);
         self.newton.start_over();
         self.step = 0;
+        Ok(())
     }
 
     /// The state at `step` of `steps` after every break the step's load causes (step 0:
@@ -191,7 +212,7 @@ impl LargeBreakingEquilibrium {
         steps: usize,
     ) -> Result<StepState, SolveError> {
         if step == 0 || step < self.step {
-            self.start_over();
+            self.start_over()?;
         }
         let cg_before = self.newton.linear_iterations();
         let mut counts = (0, 0);
@@ -199,7 +220,13 @@ impl LargeBreakingEquilibrium {
         while self.step < step {
             let target = self.step + 1;
             fracture.breaks.clear();
-            self.advance_step(target, steps, &mut fracture.breaks, &mut counts)?;
+            fracture.fallen.clear();
+            self.advance_step(
+                target,
+                steps,
+                (&mut fracture.breaks, &mut fracture.fallen),
+                &mut counts,
+            )?;
             self.step = target;
         }
         fracture.broken = self.broken.clone();
@@ -211,12 +238,13 @@ impl LargeBreakingEquilibrium {
     }
 
     /// Solve from step `step − 1`'s state to `step`'s load, breaking members at their events
-    /// (appended to `events`); Newton iterations and cuts are added to `counts`.
+    /// (appended to `events`; pieces that fall off to `fallen`); Newton iterations and cuts are
+    /// added to `counts`.
     fn advance_step(
         &mut self,
         step: usize,
         steps: usize,
-        events: &mut Vec<BreakEvent>,
+        (events, fallen): (&mut Vec<BreakEvent>, &mut Vec<FallenPiece>),
         counts: &mut (usize, usize),
     ) -> Result<(), SolveError> {
         let start = (step - 1) as Real;
@@ -266,20 +294,179 @@ impl LargeBreakingEquilibrium {
                     tooth,
                 });
             }
+            let name = self.body.name.clone();
+            let collapse = |events: &[BreakEvent], member: usize| SolveError::Collapse {
+                body: name.clone(),
+                step,
+                member,
+                breaks: events.to_vec(),
+                state: None,
+            };
+            let first = members.first().copied().unwrap_or(0);
+            if let Ok(i) = self.newton.solve_again_at(&self.body, t, step, steps) {
+                counts.0 += i;
+                // Solved: a loaded piece hanging on the rest by a mechanism is held only when
+                // the solution is stable (a pendulum in tension); balanced on a strut (a
+                // negative pivot) it is the collapse.
+                if self.newton.negative_pivots() > 0 && self.hanging_loaded() {
+                    return Err(collapse(events, self.releasing(&members)));
+                }
+                at = self.here(t);
+                continue;
+            }
+            // The weakened body cannot be solved (its tangent singular, as a linear body's
+            // stiffness is): what no longer holds on falls off, or is the collapse (named
+            // after the member whose break released it, as without large displacements).
+            let member = self.releasing(&members);
+            let pieces = match self.release_pieces() {
+                Some(pieces) if !pieces.is_empty() => pieces,
+                Some(_) => return Err(collapse(events, first)),
+                None => return Err(collapse(events, member)),
+            };
+            let held: Vec<usize> = pieces.iter().flatten().copied().collect();
+            self.newton.refit(&self.body, &held, t)?;
+            fallen.extend(
+                pieces
+                    .into_iter()
+                    .map(|nodes| FallenPiece { member, nodes }),
+            );
             match self.newton.solve_again_at(&self.body, t, step, steps) {
                 Ok(i) => counts.0 += i,
-                Err(_) => {
-                    return Err(SolveError::Collapse {
-                        body: self.body.name.clone(),
-                        step,
-                        member: members.first().copied().unwrap_or(0),
-                        breaks: events.clone(),
-                        state: None,
-                    });
-                }
+                Err(_) => return Err(collapse(events, member)),
             }
             at = self.here(t);
         }
+    }
+
+    /// Whether the pieces left without support now (see [`released_pieces`]) include a loaded
+    /// one hanging on the rest by intact members.
+    fn hanging_loaded(&self) -> bool {
+        let body = &self.body;
+        let members: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
+        let intact: Vec<bool> = (0..members.len())
+            .map(|j| body.modulus_factor(j) > 0.0)
+            .collect();
+        let dofs = &self.newton.dofs;
+        let mut supported = vec![false; body.nodes.len()];
+        for &dof in &dofs.supported {
+            supported[dof / dofs.dofs_per_node] = true;
+        }
+        let pieces = released_pieces(
+            &members,
+            &intact,
+            &supported,
+            &self.fallen_node,
+            dofs.dofs_per_node,
+        );
+        let mut released = self.fallen_node.clone();
+        for &n in pieces.iter().flatten() {
+            released[n] = true;
+        }
+        hanging_loaded(body, &members, &intact, &pieces, &released)
+    }
+
+    /// The member of an event (`members`, in the order they broke) whose break released
+    /// pieces, the members after it left intact (the first, when none did): the member the
+    /// linear path names, which removes them one by one.
+    fn releasing(&self, members: &[usize]) -> usize {
+        let body = &self.body;
+        let nodes: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
+        let dofs = &self.newton.dofs;
+        let mut supported = vec![false; body.nodes.len()];
+        for &dof in &dofs.supported {
+            supported[dof / dofs.dofs_per_node] = true;
+        }
+        let mut intact: Vec<bool> = (0..nodes.len())
+            .map(|j| body.modulus_factor(j) > 0.0)
+            .collect();
+        for &m in members {
+            intact[m] = true;
+        }
+        for &m in members {
+            intact[m] = body.modulus_factor(m) > 0.0;
+            let released = released_pieces(
+                &nodes,
+                &intact,
+                &supported,
+                &self.fallen_node,
+                dofs.dofs_per_node,
+            );
+            if !released.is_empty() {
+                return m;
+            }
+        }
+        members.first().copied().unwrap_or(0)
+    }
+
+    /// After a break: the pieces left without support (see [`released_pieces`]; nodes
+    /// ascending, by first node), taken out of the solve (their members' modulus factors 0,
+    /// their loads and the pressures on their faces dropped, their nodes held); empty when
+    /// nothing came loose. `None` (nothing removed) when what came loose is the structure's
+    /// collapse, as [`BreakingEquilibrium`](super::BreakingEquilibrium) decides it: a loaded
+    /// piece still hanging on the rest by intact members, or a loss after which nothing loads
+    /// the rest (no load, no pressure, no support that moves).
+    fn release_pieces(&mut self) -> Option<Vec<Vec<usize>>> {
+        let body = &self.body;
+        let members: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
+        let intact: Vec<bool> = (0..members.len())
+            .map(|j| body.modulus_factor(j) > 0.0)
+            .collect();
+        let dofs = &self.newton.dofs;
+        let mut supported = vec![false; body.nodes.len()];
+        for &dof in &dofs.supported {
+            supported[dof / dofs.dofs_per_node] = true;
+        }
+        let pieces = released_pieces(
+            &members,
+            &intact,
+            &supported,
+            &self.fallen_node,
+            dofs.dofs_per_node,
+        );
+        if pieces.is_empty() {
+            return Some(pieces);
+        }
+        let mut released = self.fallen_node.clone();
+        for &n in pieces.iter().flatten() {
+            released[n] = true;
+        }
+        if hanging_loaded(body, &members, &intact, &pieces, &released) {
+            return None;
+        }
+        let rest_loaded = (0..body.nodes.len()).any(|n| !released[n] && loaded(body, n))
+            || body
+                .supports
+                .iter()
+                .any(|s| !released[s.node] && s.displacement != nalgebra::Vector3::zeros());
+        if !rest_loaded {
+            return None;
+        }
+        self.fallen_node = released;
+        let gone = &self.fallen_node;
+        let body = &mut self.body;
+        if body.member_factors.len() != body.members.len() {
+            body.member_factors = vec![1.0; body.members.len()];
+        }
+        for (j, &[a, b]) in members.iter().enumerate() {
+            if gone[a] || gone[b] {
+                body.member_factors[j] = 0.0;
+            }
+        }
+        body.loads.retain(|l| !gone[l.node]);
+        for p in &mut body.pressures {
+            match &mut p.faces {
+                PressureFaces::Patches(faces) => faces.retain(|f| !f.iter().any(|&n| gone[n])),
+                PressureFaces::Segments(faces) => faces.retain(|f| !f.iter().any(|&n| gone[n])),
+            }
+        }
+        body.pressures.retain(|p| !p.faces.is_empty());
+        body.supports.extend(
+            pieces
+                .iter()
+                .flatten()
+                .map(|&n| Support::fixed(n, [true; 3])),
+        );
+        Some(pieces)
     }
 
     /// A Newton failure after members broke in this step (`events`) is the body's collapse:
@@ -417,4 +604,37 @@ impl LargeBreakingEquilibrium {
             }
         }
     }
+}
+
+/// Whether one of `pieces` (nodes ascending) of `body` carries a load (a nodal force or a
+/// pressure on a face of it) and still hangs on the rest (nodes not `released`) by a member
+/// that is `intact`: a mechanism under load.
+fn hanging_loaded(
+    body: &Body,
+    members: &[[usize; 2]],
+    intact: &[bool],
+    pieces: &[Vec<usize>],
+    released: &[bool],
+) -> bool {
+    let hanging = |piece: &[usize]| {
+        members.iter().zip(intact).any(|(&[a, b], &i)| {
+            i && (piece.binary_search(&a).is_ok() && !released[b]
+                || piece.binary_search(&b).is_ok() && !released[a])
+        })
+    };
+    pieces
+        .iter()
+        .any(|piece| hanging(piece) && piece.iter().any(|&n| loaded(body, n)))
+}
+
+/// Whether node `n` of `body` carries a load: a nodal force, or a pressure on a face of it.
+fn loaded(body: &Body, n: usize) -> bool {
+    body.loads
+        .iter()
+        .any(|l| l.node == n && l.force != nalgebra::Vector3::zeros())
+        || body
+            .pressures
+            .iter()
+            .filter(|p| p.pressure != 0.0)
+            .any(|p| p.faces.nodes().any(|f| f.contains(&n)))
 }

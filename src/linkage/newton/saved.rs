@@ -2,8 +2,9 @@
 //! same stretch of the load path again and again from one converged state
 //! ([`crate::linkage::fracture::LargeBreakingEquilibrium`]).
 
-use super::{NewtonEquilibrium, PATH_POINTS};
-use crate::linkage::{Body, SolveError};
+use super::{pair_members, NewtonEquilibrium, PATH_POINTS};
+use crate::linkage::tangent_solver::TangentSolver;
+use crate::linkage::{Body, DofMap, SolveError, StiffnessAssembly};
 use crate::Real;
 
 /// What a [`NewtonEquilibrium`] carries from one increment to the next: the displacement, the
@@ -132,6 +133,43 @@ impl NewtonEquilibrium {
         cg_before: usize,
     ) -> Result<crate::linkage::StepState, SolveError> {
         self.finish_step(body, (step, steps), (iterations, cuts), cg_before)
+    }
+
+    /// Negative pivots of the last tangent factored (0 with conjugate gradients: unknown).
+    pub fn negative_pivots(&self) -> usize {
+        self.negative_pivots
+    }
+
+    /// Take `body`'s supports anew (nodes of pieces that fell off held, or given back): its DOF
+    /// map, the tangent's pattern and solver. The nodes `held` (now held where they were made)
+    /// go back to their undeformed places; the converged path restarts at pseudo-time `t`.
+    pub fn refit(&mut self, body: &Body, held: &[usize], t: Real) -> Result<(), SolveError> {
+        let dofs = DofMap::new(body);
+        let assembly = StiffnessAssembly::new(body, &dofs)?;
+        let solver = if assembly.n > 0 {
+            Some(TangentSolver::new(body, &dofs, &assembly).map_err(|e| {
+                SolveError::Factorization {
+                    body: body.name.clone(),
+                    message: e.to_string(),
+                }
+            })?)
+        } else {
+            None
+        };
+        let d = dofs.dofs_per_node;
+        for &n in held {
+            self.u[n * d..(n + 1) * d].iter_mut().for_each(|v| *v = 0.0);
+        }
+        self.previous = vec![0.0; assembly.n];
+        self.values.clear();
+        self.dofs = dofs;
+        self.assembly = assembly;
+        self.solver = solver;
+        if !body.pressures.is_empty() {
+            self.pair_members = pair_members(body);
+        }
+        self.restart_path(t);
+        Ok(())
     }
 
     /// Start over from the undeformed, unloaded state (step 0).
