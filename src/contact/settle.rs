@@ -33,11 +33,13 @@ use std::time::Instant;
 /// each active contact adding its penalty stiffness `k n nᵀ` (implicit penalty). Then every
 /// node is projected on the obstacles: the nodes inside one form the next set (a node of the
 /// set that came out, pulled by its penalty, leaves it). The step has settled when the set
-/// found is the set solved. A set seen before (the contact flips back and forth) is settled
-/// again from the union of the sets of the cycle, a contact staying while it still presses
-/// (depth > 0 along its normal, see `contact::pressing`); a set that flips even so fails the
-/// step ([`ContactError::Flips`], retried with a smaller increment first). Running out of
-/// contact iterations ends the loop with a warning. When every body is linear, the Newton runs
+/// found is the set solved. A set seen before (the contact flips back and forth) has settled
+/// when the set solved is within a penetration tolerance of the set found (see
+/// `contact::pressing`); where only obstacle contacts come and go it is settled again keeping
+/// the obstacle contacts of the set solved that still press (depth > 0 along their normal),
+/// and if it flips even so, the loop goes back to the set solved when it first flipped, with a
+/// warning naming the nodes. Other flips, and running out of contact iterations, keep the last
+/// set solved with a warning. When every body is linear, the Newton runs
 /// on the contact candidates instead ([`CondensedSolver`]).
 pub struct ContactSolver {
     pub(crate) parts: Vec<BodyPart>,
