@@ -515,6 +515,15 @@ penalty = 1e9
     for (summary, name) in [(&with, "three_bar"), (&without, "three_bar_alone")] {
         assert_eq!(summary.steps.len(), 2, "{:?}", summary.steps);
         assert!(summary.steps[1].collapse && !summary.steps[0].collapse);
+        // Its out-of-balance (the broken members' load is on) is not a solve that stopped short.
+        assert!(
+            !summary.steps[1]
+                .warnings
+                .iter()
+                .any(|w| w.contains("out-of-balance")),
+            "{name}: {:?}",
+            summary.steps[1].warnings
+        );
         assert_eq!(summary.steps[1].step, 1);
         assert_eq!(summary.steps[1].broken, Some(3));
         let last = step_json(d, name, 1);

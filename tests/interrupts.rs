@@ -483,25 +483,39 @@ fn sigterm_and_sigint_while_writing_vtk_exit_130_and_keep_the_old_vtk() {
     let vtk = contents(&results.join("vtk"));
     assert_eq!(vtk.len(), 22, "21 steps and the collection");
     let earlier = std::fs::read(results.join("summary.json")).unwrap();
+    let args: Vec<&std::ffi::OsStr> = vec![
+        "render".as_ref(),
+        results.as_os_str(),
+        "--vtk".as_ref(),
+        "--no-png".as_ref(),
+        "--no-gif".as_ref(),
+    ];
+    // The render timed once, uninterrupted (it writes the same files again): the signals come
+    // at a quarter and at a half of its time, within its reading and writing (fixed moments of
+    // 0.7 and 1.2 s came after the VTK files were written on a quiet machine).
+    let timed = std::time::Instant::now();
+    let o = linkage().args(&args).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let render = timed.elapsed();
+    assert!(
+        contents(&results.join("vtk")) == vtk,
+        "render --vtk wrote other files"
+    );
     for (k, signal) in [libc::SIGTERM, libc::SIGINT].into_iter().enumerate() {
-        let args: Vec<&std::ffi::OsStr> = vec![
-            "render".as_ref(),
-            results.as_os_str(),
-            "--vtk".as_ref(),
-            "--no-png".as_ref(),
-            "--no-gif".as_ref(),
-        ];
-        let s = interrupt(&args, Duration::from_millis(700 + 500 * k as u64), signal);
-        let what = format!("render --vtk, signal {signal}");
+        let at = render.mul_f64(0.25 * (k + 1) as f64);
+        let s = interrupt(&args, at, signal);
+        let what = format!("render --vtk, signal {signal} at {at:?} of {render:?}");
         assert_ne!(s.code, Some(-1), "{what}: ended before the signal");
         assert_eq!(s.code, Some(130), "{what}: {}", s.stderr);
         assert!(s.seconds < 5.0, "{what}: {:.2} s to stop", s.seconds);
         // The signal lands in the writing or, earlier, in the reading of the stored results
         // (interruptible too since issue 33's item 2 was finished): both stop before a file.
+        // Under load it can land between phases, which the handler's own line says.
         assert!(
             s.stderr.contains("interrupted while writing the VTK files")
                 || s.stderr
-                    .contains("interrupted while reading the stored results"),
+                    .contains("interrupted while reading the stored results")
+                || s.stderr.trim_end().ends_with("again to quit at once"),
             "{what}: {}",
             s.stderr
         );
