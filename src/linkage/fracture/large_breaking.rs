@@ -341,6 +341,13 @@ impl LargeBreakingEquilibrium {
     /// Whether the pieces left without support now (see [`released_pieces`]) include a loaded
     /// one hanging on the rest by intact members.
     fn hanging_loaded(&self) -> bool {
+        let l = self.loose();
+        hanging_loaded(&self.body, &l.members, &l.intact, &l.pieces, &l.released)
+    }
+
+    /// The body's members (node pairs), which of them are intact and which nodes are
+    /// supported.
+    fn topology(&self) -> (Vec<[usize; 2]>, Vec<bool>, Vec<bool>) {
         let body = &self.body;
         let members: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
         let intact: Vec<bool> = (0..members.len())
@@ -351,18 +358,30 @@ impl LargeBreakingEquilibrium {
         for &dof in &dofs.supported {
             supported[dof / dofs.dofs_per_node] = true;
         }
+        (members, intact, supported)
+    }
+
+    /// The pieces left without support now (see [`released_pieces`]), with the topology they
+    /// were found in.
+    fn loose(&self) -> Loose {
+        let (members, intact, supported) = self.topology();
         let pieces = released_pieces(
             &members,
             &intact,
             &supported,
             &self.fallen_node,
-            dofs.dofs_per_node,
+            self.newton.dofs.dofs_per_node,
         );
         let mut released = self.fallen_node.clone();
         for &n in pieces.iter().flatten() {
             released[n] = true;
         }
-        hanging_loaded(body, &members, &intact, &pieces, &released)
+        Loose {
+            members,
+            intact,
+            pieces,
+            released,
+        }
     }
 
     /// The member of an event (`members`, in the order they broke) whose break released
@@ -370,15 +389,7 @@ impl LargeBreakingEquilibrium {
     /// linear path names, which removes them one by one.
     fn releasing(&self, members: &[usize]) -> usize {
         let body = &self.body;
-        let nodes: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
-        let dofs = &self.newton.dofs;
-        let mut supported = vec![false; body.nodes.len()];
-        for &dof in &dofs.supported {
-            supported[dof / dofs.dofs_per_node] = true;
-        }
-        let mut intact: Vec<bool> = (0..nodes.len())
-            .map(|j| body.modulus_factor(j) > 0.0)
-            .collect();
+        let (nodes, mut intact, supported) = self.topology();
         for &m in members {
             intact[m] = true;
         }
@@ -389,7 +400,7 @@ impl LargeBreakingEquilibrium {
                 &intact,
                 &supported,
                 &self.fallen_node,
-                dofs.dofs_per_node,
+                self.newton.dofs.dofs_per_node,
             );
             if !released.is_empty() {
                 return m;
@@ -406,30 +417,16 @@ impl LargeBreakingEquilibrium {
     /// piece still hanging on the rest by intact members, or a loss after which nothing loads
     /// the rest (no load, no pressure, no support that moves).
     fn release_pieces(&mut self) -> Option<Vec<Vec<usize>>> {
-        let body = &self.body;
-        let members: Vec<[usize; 2]> = body.members.iter().map(|x| x.nodes).collect();
-        let intact: Vec<bool> = (0..members.len())
-            .map(|j| body.modulus_factor(j) > 0.0)
-            .collect();
-        let dofs = &self.newton.dofs;
-        let mut supported = vec![false; body.nodes.len()];
-        for &dof in &dofs.supported {
-            supported[dof / dofs.dofs_per_node] = true;
-        }
-        let pieces = released_pieces(
-            &members,
-            &intact,
-            &supported,
-            &self.fallen_node,
-            dofs.dofs_per_node,
-        );
+        let Loose {
+            members,
+            intact,
+            pieces,
+            released,
+        } = self.loose();
         if pieces.is_empty() {
             return Some(pieces);
         }
-        let mut released = self.fallen_node.clone();
-        for &n in pieces.iter().flatten() {
-            released[n] = true;
-        }
+        let body = &self.body;
         if hanging_loaded(body, &members, &intact, &pieces, &released) {
             return None;
         }
@@ -637,4 +634,16 @@ fn loaded(body: &Body, n: usize) -> bool {
             .iter()
             .filter(|p| p.pressure != 0.0)
             .any(|p| p.faces.nodes().any(|f| f.contains(&n)))
+}
+
+/// The pieces a break left without support, and the topology they were found in.
+struct Loose {
+    /// Each member's nodes.
+    members: Vec<[usize; 2]>,
+    /// Whether each member is intact.
+    intact: Vec<bool>,
+    /// The pieces without support (nodes ascending, by first node).
+    pieces: Vec<Vec<usize>>,
+    /// Every node released: fallen before, or in one of the pieces.
+    released: Vec<bool>,
 }
