@@ -5,6 +5,8 @@ use linkage::contact::ContactError;
 use linkage::scene::{load_scene, RunError, Simulation, StepResult, StepSummary};
 use std::path::{Path, PathBuf};
 
+mod common;
+
 /// Every step of the scene at `path`, with its summary.
 #[allow(clippy::result_large_err)]
 fn run(path: &Path) -> Result<Vec<(StepResult, StepSummary)>, RunError> {
@@ -123,55 +125,6 @@ fn a_body_resting_on_a_frictionless_floor_without_supports_is_told_which_motions
     );
 }
 
-/// A 3D cube of one cell on a floor, pressed by 400 N and pushed along x by `push` N on its
-/// nodes at height `at` (m; 0.1 is its top: tests/friction.rs's pushed cube) (half at step 1),
-/// all its nodes held in z, μ = 0.5.
-fn pushed_cube(dir: &Path, push: f64, at: f64) -> PathBuf {
-    scene(
-        dir,
-        "pushed.toml",
-        &format!(
-            r#"name = "pushed"
-steps = 2
-
-[[materials]]
-name = "stiff"
-youngs_modulus = 1e12
-area = 1e-2
-
-[[bodies]]
-name = "block"
-box_lattice = {{ size = [0.1, 0.1, 0.1], cells = [1, 1, 1] }}
-material = "stiff"
-
-[[bodies.supports]]
-inside = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 1.0, 1.0] }}
-fix = ["z"]
-
-[[bodies.loads]]
-on_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }}
-total_force = [0.0, -400.0, 0.0]
-schedule = [1.0, 1.0]
-
-[[bodies.loads]]
-on_plane = {{ point = [0.0, {at:?}, 0.0], normal = [0.0, 1.0, 0.0] }}
-total_force = [{push:?}, 0.0, 0.0]
-schedule = [0.5, 1.0]
-
-[[obstacles]]
-name = "floor"
-shape = "half_space"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 1.0, 0.0]
-
-[contact]
-friction = 0.5
-stick_stiffness = 1e6
-"#
-        ),
-    )
-}
-
 /// Case 4, **a block pushed at exactly μN**: pushed by 200 N = μ N (μ = 0.5, N = 400 N) the
 /// block is at the edge of sliding. It is solved at the limit: friction carries the push, Σ
 /// tangential = −200 N = −μ Σ normal (to 1e-9 relative), every contact at μ times its normal
@@ -183,7 +136,7 @@ stick_stiffness = 1e6
 #[test]
 fn a_block_pushed_at_exactly_mu_n_is_solved_at_the_limit() {
     let dir = tempfile::tempdir().unwrap();
-    let edge = run(&pushed_cube(dir.path(), 200.0, 0.1)).unwrap_or_else(|e| panic!("{e}"));
+    let edge = run(&common::pushed_cube(dir.path(), 200.0, 0.1)).unwrap_or_else(|e| panic!("{e}"));
     let step = &edge.last().unwrap().0.bodies[0];
     let along: f64 = step.contacts.iter().map(|c| c.tangential_force[0]).sum();
     let normal: f64 = step.contacts.iter().map(|c| c.normal_force).sum();
@@ -193,7 +146,7 @@ fn a_block_pushed_at_exactly_mu_n_is_solved_at_the_limit() {
         let t = c.tangential_force.iter().map(|f| f * f).sum::<f64>().sqrt();
         assert!((t - 0.5 * c.normal_force).abs() < 1e-9 * 400.0, "{c:?}");
     }
-    let err = run(&pushed_cube(dir.path(), 202.0, 0.1)).unwrap_err();
+    let err = run(&common::pushed_cube(dir.path(), 202.0, 0.1)).unwrap_err();
     assert!(
         matches!(
             &err,
@@ -205,7 +158,7 @@ fn a_block_pushed_at_exactly_mu_n_is_solved_at_the_limit() {
         "{err}"
     );
     // 0.99 μ N on its base (no tipping moment: every contact presses with 100 N) sticks.
-    let held = run(&pushed_cube(dir.path(), 198.0, 0.0)).unwrap_or_else(|e| panic!("{e}"));
+    let held = run(&common::pushed_cube(dir.path(), 198.0, 0.0)).unwrap_or_else(|e| panic!("{e}"));
     let step = &held.last().unwrap().0.bodies[0];
     let friction: f64 = step.contacts.iter().map(|c| c.tangential_force[0]).sum();
     assert!((friction + 198.0).abs() < 1e-9 * 400.0, "{friction}");

@@ -6,6 +6,8 @@ use linkage::contact::ContactError;
 use linkage::scene::{load_scene, RunError, Simulation, StepResult, StepSummary};
 use std::path::Path;
 
+mod common;
+
 /// A 2D body of two nodes 0.1 m apart on a floor (y = 0), each pressed down by 100 N from
 /// step 1, node 1 pulled along x by the prescribed `travel` (m) on `schedule`; friction as
 /// `contact` gives it. Stiff members (E A / L = 1e11 N/m) against a stick stiffness of 1e6
@@ -156,55 +158,10 @@ fn a_load_unload_cycle_traces_the_closed_hysteresis_loop_of_the_closed_form() {
     assert!((first.1 - last.1).abs() < 1e-9 * mu_n && (first.0 - last.0).abs() < 1e-12);
 }
 
-/// A 3D cube of one cell on a floor, pressed by 400 N and pushed along x by `push` N at its
-/// top, all its nodes held in z.
-fn pushed_cube(dir: &Path, push: f64) -> std::path::PathBuf {
-    let text = format!(
-        r#"name = "pushed"
-steps = 2
-
-[[materials]]
-name = "stiff"
-youngs_modulus = 1e12
-area = 1e-2
-
-[[bodies]]
-name = "block"
-box_lattice = {{ size = [0.1, 0.1, 0.1], cells = [1, 1, 1] }}
-material = "stiff"
-
-[[bodies.supports]]
-inside = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 1.0, 1.0] }}
-fix = ["z"]
-
-[[bodies.loads]]
-on_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }}
-total_force = [0.0, -400.0, 0.0]
-schedule = [1.0, 1.0]
-
-[[bodies.loads]]
-on_plane = {{ point = [0.0, 0.1, 0.0], normal = [0.0, 1.0, 0.0] }}
-total_force = [{push:?}, 0.0, 0.0]
-schedule = [0.5, 1.0]
-
-[[obstacles]]
-name = "floor"
-shape = "half_space"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 1.0, 0.0]
-
-{FRICTION}
-"#
-    );
-    let path = dir.join("pushed.toml");
-    std::fs::write(&path, text).unwrap();
-    path
-}
-
 #[test]
 fn a_block_pushed_below_mu_n_is_held_and_above_it_is_reported_sliding() {
     let dir = tempfile::tempdir().unwrap();
-    let held = run(&pushed_cube(dir.path(), 160.0)).unwrap();
+    let held = run(&common::pushed_cube(dir.path(), 160.0, 0.1)).unwrap();
     let step = &held.last().unwrap().0.bodies[0];
     let friction: f64 = step.contacts.iter().map(|c| c.tangential_force[0]).sum();
     assert!((friction + 160.0).abs() < 1e-9 * 400.0, "{friction}");
@@ -215,7 +172,7 @@ fn a_block_pushed_below_mu_n_is_held_and_above_it_is_reported_sliding() {
         .map(|u| u[0].abs())
         .fold(0.0, f64::max);
     assert!(largest <= 0.5 * 400.0 / 1e6, "{largest}");
-    let err = run(&pushed_cube(dir.path(), 240.0)).unwrap_err();
+    let err = run(&common::pushed_cube(dir.path(), 240.0, 0.1)).unwrap_err();
     let RunError::Contact {
         source:
             ContactError::Sliding {

@@ -172,3 +172,55 @@ pub fn table_without_seconds(path: &Path) -> Vec<linkage::scene::batch::Row> {
     }
     rows
 }
+
+/// A 3D cube of one cell (E = 1e12 Pa) on a floor, pressed by 400 N and pushed along x by
+/// `push` N on its nodes at height `at` (m; 0.1 is its top), half of it at step 1 of 2, all
+/// its nodes held in z, μ = 0.5 (stick stiffness 1e6 N/m): `dir/pushed.toml`.
+#[allow(dead_code)] // not every test binary pushes the cube
+pub fn pushed_cube(dir: &Path, push: f64, at: f64) -> PathBuf {
+    let path = dir.join("pushed.toml");
+    std::fs::write(
+        &path,
+        format!(
+            r#"name = "pushed"
+steps = 2
+
+[[materials]]
+name = "stiff"
+youngs_modulus = 1e12
+area = 1e-2
+
+[[bodies]]
+name = "block"
+box_lattice = {{ size = [0.1, 0.1, 0.1], cells = [1, 1, 1] }}
+material = "stiff"
+
+[[bodies.supports]]
+inside = {{ min = [-1.0, -1.0, -1.0], max = [1.0, 1.0, 1.0] }}
+fix = ["z"]
+
+[[bodies.loads]]
+on_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }}
+total_force = [0.0, -400.0, 0.0]
+schedule = [1.0, 1.0]
+
+[[bodies.loads]]
+on_plane = {{ point = [0.0, {at:?}, 0.0], normal = [0.0, 1.0, 0.0] }}
+total_force = [{push:?}, 0.0, 0.0]
+schedule = [0.5, 1.0]
+
+[[obstacles]]
+name = "floor"
+shape = "half_space"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+
+[contact]
+friction = 0.5
+stick_stiffness = 1e6
+"#
+        ),
+    )
+    .unwrap();
+    path
+}
