@@ -6,7 +6,7 @@ use linkage::linkage::fracture::BreakingEquilibrium;
 use linkage::linkage::{Body, Dimension, Failure, Material, Member, Schedule, Support};
 use linkage::scene::{load_scene, run, Summary};
 use nalgebra::Vector3;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// E A of every member, N, and the tensile strength times the area, N.
 const EA: f64 = 200e9 * 1e-4;
@@ -830,40 +830,10 @@ fn the_softening_variant_of_paper_fracture_passes_its_teeth_then_collapses() {
 #[test]
 fn failure_that_the_results_hide() {
     let dir = tempfile::tempdir().unwrap();
-    let here = std::env::current_dir()
-        .unwrap()
-        .join("scenes/plate_with_hole.txt");
-    let scene = dir.path().join("plate.toml");
-    std::fs::write(
-        &scene,
-        format!(
-            r#"name = "plate"
-steps = 20
-[[materials]]
-name = "brittle"
-youngs_modulus = 200e9
-area = 1e-5
-tensile_strength = 100e6
-failure = "break"
-[[bodies]]
-name = "plate"
-outline = {{ file = "{}", spacing = 0.02 }}
-material = "brittle"
-[[bodies.supports]]
-on_line = {{ point = [0.0, 0.0], direction = [0.0, 1.0] }}
-fix = ["x"]
-[[bodies.supports]]
-nearest = [0.0, 0.0]
-fix = ["y"]
-[[bodies.supports]]
-on_line = {{ point = [0.4, 0.0], direction = [0.0, 1.0] }}
-fix = ["x", "y"]
-displacement = [0.001, 0.0]
-"#,
-            here.display()
-        ),
-    )
-    .unwrap();
+    let scene = brittle_plate(
+        dir.path(),
+        "[[bodies.supports]]\non_line = { point = [0.4, 0.0], direction = [0.0, 1.0] }\nfix = [\"x\", \"y\"]\ndisplacement = [0.001, 0.0]\n",
+    );
     let world = load_scene(&scene).unwrap();
     let summary = run(&world, &dir.path().join("out"), &|| {}).expect("a result");
     assert!(summary.collapse.is_none() && summary.failure.is_none());
@@ -922,39 +892,10 @@ displacement = [0.001, 0.0]
 #[test]
 fn failure_that_the_results_hide_under_force_control() {
     let dir = tempfile::tempdir().unwrap();
-    let here = std::env::current_dir()
-        .unwrap()
-        .join("scenes/plate_with_hole.txt");
-    let scene = dir.path().join("plate.toml");
-    std::fs::write(
-        &scene,
-        format!(
-            r#"name = "plate"
-steps = 20
-[[materials]]
-name = "brittle"
-youngs_modulus = 200e9
-area = 1e-5
-tensile_strength = 100e6
-failure = "break"
-[[bodies]]
-name = "plate"
-outline = {{ file = "{}", spacing = 0.02 }}
-material = "brittle"
-[[bodies.supports]]
-on_line = {{ point = [0.0, 0.0], direction = [0.0, 1.0] }}
-fix = ["x"]
-[[bodies.supports]]
-nearest = [0.0, 0.0]
-fix = ["y"]
-[[bodies.loads]]
-on_line = {{ point = [0.4, 0.0], direction = [0.0, 1.0] }}
-total_force = [20000.0, 0.0]
-"#,
-            here.display()
-        ),
-    )
-    .unwrap();
+    let scene = brittle_plate(
+        dir.path(),
+        "[[bodies.loads]]\non_line = { point = [0.4, 0.0], direction = [0.0, 1.0] }\ntotal_force = [20000.0, 0.0]\n",
+    );
     let world = load_scene(&scene).unwrap();
     let summary = run(&world, &dir.path().join("out"), &|| {}).expect("a result");
     let collapse = summary.collapse.as_ref().expect("a collapse");
@@ -1053,4 +994,41 @@ force = [0.0, -40000.0]
     let step2 = step_file(d, "g", 2).unwrap();
     let n = step2["bodies"][0]["axial_forces"][0].as_f64().unwrap();
     assert!(close(n, 20000.0 + weight / 2.0, 1e-12), "{n}");
+}
+
+/// Issue 32 case 7's plate: the bundled plate with a hole (members of about 2 cm) of a brittle
+/// material (E = 200 GPa, A = 1e-5 m², 100 MPa, breaking), held on its left edge, 20 steps,
+/// pulled on its right edge as `right` (TOML) says: `dir/plate.toml`.
+fn brittle_plate(dir: &Path, right: &str) -> PathBuf {
+    let here = std::env::current_dir()
+        .unwrap()
+        .join("scenes/plate_with_hole.txt");
+    let scene = dir.join("plate.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"name = "plate"
+steps = 20
+[[materials]]
+name = "brittle"
+youngs_modulus = 200e9
+area = 1e-5
+tensile_strength = 100e6
+failure = "break"
+[[bodies]]
+name = "plate"
+outline = {{ file = "{}", spacing = 0.02 }}
+material = "brittle"
+[[bodies.supports]]
+on_line = {{ point = [0.0, 0.0], direction = [0.0, 1.0] }}
+fix = ["x"]
+[[bodies.supports]]
+nearest = [0.0, 0.0]
+fix = ["y"]
+{right}"#,
+            here.display()
+        ),
+    )
+    .unwrap();
+    scene
 }
